@@ -1,0 +1,35 @@
+"""ropesim: a rope simulator. N point masses joined by stiff springs, under gravity and air drag.
+
+    import ropesim
+    scene = ropesim.load_scene("scenarios/helicopter_mass.toml", ["integrator.t_end=10"])
+    traj = ropesim.simulate(scene)            # in memory; or simulate(scene, "runs/x") to write a run folder
+    traj.x[-1]                                # final positions, (N, D) [m]
+    ropesim.Trajectory.open("runs/x")         # read a run folder lazily
+
+Heavy modules (numba, matplotlib) load only when first used, so the command line starts fast.
+"""
+
+__version__ = "0.1.0"
+
+__all__ = ["load_scene", "scene_from_toml", "SceneError", "Scene", "simulate", "build", "Trajectory",
+           "RunFolderError", "METHODS", "scene_to_toml"]
+
+_LAZY = {
+    "load_scene": "loader", "scene_from_toml": "loader", "SceneError": "loader",
+    "Scene": "scene", "scene_to_toml": "scene",
+    "simulate": "run", "build": "build",
+    "Trajectory": "trajectory", "RunFolderError": "trajectory",
+    "METHODS": "integrators",
+}
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    raise AttributeError(f"module 'ropesim' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(list(globals()) + __all__)

@@ -1,0 +1,71 @@
+"""The run summary (``summary.json``): how the run went, its energy, and the scene's own figures."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import __version__
+from ..build import Model, stability_frequency
+from ..forces.springs import pair_spring_stretch
+from ..integrators import get_method
+from .energy import energy_terms
+from .towed import towed_end, towed_figures
+
+FRAME_BLOCK = 256  # frames per block when scanning a (possibly memory-mapped) trajectory
+
+
+def largest_stretch(model: Model, x: np.ndarray) -> tuple[float, float]:
+    """The largest relative spring stretch |r| / l - 1 over all saved frames, and the time index it occurs."""
+    rope = model.scene.rope
+    best, where = -np.inf, 0
+    for start in range(0, len(x), FRAME_BLOCK):
+        stretch = pair_spring_stretch(x[start:start + FRAME_BLOCK], rope.segment_length, 1, rope.closed)
+        per_frame = stretch.max(axis=1)
+        k = int(np.argmax(per_frame))
+        if per_frame[k] > best:
+            best, where = float(per_frame[k]), start + k
+    return best, where
+
+
+def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> dict:
+    """Everything a user wants to know about a finished (or stopped) run, as JSON-ready values."""
+    scene = model.scene
+    grid = outcome.grid
+    scheme = get_method(scene.integrator.method)
+    omega = stability_frequency(model)
+    node_steps = outcome.steps * model.nodes
+    summary: dict = {
+        "scene": scene.name,
+        "ropesim_version": __version__,
+        "status": outcome.status,
+        "t_end": float(t[-1]),
+        "t_end_requested": scene.integrator.t_end,
+        "method": scene.integrator.method,
+        "dt": grid.dt,
+        "steps": outcome.steps,
+        "frames": int(len(t)),
+        "nodes": model.nodes,
+        "wall_time_s": round(outcome.wall_time, 6),
+        "compile_time_s": round(outcome.compile_time, 6),
+        "steps_per_second": round(outcome.steps / outcome.wall_time, 1) if outcome.wall_time > 0 else None,
+        "node_steps_per_second": round(node_steps / outcome.wall_time, 1) if outcome.wall_time > 0 else None,
+        "stable_dt_bound": scheme.stability_limit / omega if omega > 0 else None,
+    }
+    if outcome.message:
+        summary["message"] = outcome.message
+    if grid.dt_adjusted:
+        summary["dt_requested"] = grid.requested_dt
+    finite = bool(np.all(np.isfinite(x[-1])) and np.all(np.isfinite(v[-1])))
+    if finite:
+        energy = energy_terms(model, x[-1], v[-1])
+        summary["final_energy_J"] = {k: float(val) for k, val in energy.items()}
+        stretch, at = largest_stretch(model, x)
+        summary["max_spring_stretch"] = stretch
+        summary["max_spring_stretch_t"] = float(t[at])
+        if towed_end(scene) is not None:
+            summary["towed"] = towed_figures(model, x[-1])
+        if scene.thrower is not None and scene.rope.closed:
+            from .shooter import shooter_figures
+
+            summary["shooter"] = shooter_figures(model, t, x)
+    return summary

@@ -1,0 +1,374 @@
+"""Read a scene file (TOML) strictly into a :class:`ropesim.scene.Scene`.
+
+Every refusal is a :class:`SceneError` whose message is one line: the file, the key path and what is
+allowed, e.g. ``scenarios/x.toml: rope.mass: must be a number > 0, got -1``.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import tomllib
+from dataclasses import fields, replace
+from pathlib import Path
+from typing import Any
+
+from . import scene as S
+
+
+class SceneError(ValueError):
+    """A scene that cannot be used; ``str()`` is the one line to show the user."""
+
+    def __init__(self, source: str, key: str, message: str):
+        self.source, self.key, self.message = source, key, message
+        where = f"{source}: {key}: " if key else f"{source}: "
+        super().__init__(" ".join(f"{where}{message}".split()))
+
+
+def load_scene(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> S.Scene:
+    """Load and validate a scene file, applying ``--set`` style ``KEY=VALUE`` overrides first."""
+    path = Path(path)
+    source = str(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise SceneError(source, "", "no such scene file") from None
+    except IsADirectoryError:
+        raise SceneError(source, "", "is a folder, not a scene file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SceneError(source, "", f"cannot be read ({exc.__class__.__name__})") from None
+    return scene_from_toml(text, source=source, default_name=path.stem, overrides=overrides)
+
+
+def scene_from_toml(text: str, source: str = "<scene>", default_name: str = "scene",
+                    overrides: list[str] | tuple[str, ...] = ()) -> S.Scene:
+    """Parse TOML text into a validated scene (see :func:`load_scene`)."""
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(source, "", f"not valid TOML: {exc}") from None
+    for item in overrides:
+        apply_override(raw, item, source)
+    if overrides:
+        source = f"{source} (with --set {' '.join(overrides)})"
+    return scene_from_dict(raw, source=source, default_name=default_name)
+
+
+def parse_override(item: str, source: str = "--set") -> tuple[list[str], Any]:
+    """Split ``a.b.c=VALUE`` into its key path and a TOML-typed value (bare words are strings)."""
+    key, sep, text = item.partition("=")
+    key = key.strip()
+    if not sep or not key:
+        raise SceneError(source, "--set", f"expected KEY=VALUE (a dotted key such as integrator.dt=0.002), "
+                                          f"got {item!r}")
+    try:
+        value = tomllib.loads(f"v = {text.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = text.strip()
+    return key.split("."), value
+
+
+def apply_override(raw: dict, item: str, source: str = "--set") -> None:
+    """Set one ``--set KEY=VALUE`` in the raw TOML dict; integer path parts index arrays of tables."""
+    parts, value = parse_override(item, source)
+    node: Any = raw
+    for depth, part in enumerate(parts[:-1]):
+        here = ".".join(parts[: depth + 1])
+        if isinstance(node, list):
+            node = _list_item(node, part, here, source, item)
+        elif isinstance(node, dict):
+            if part not in node:
+                node[part] = [{}] if part in S.ARRAYS_OF_TABLES and parts[depth + 1].isdigit() else {}
+            node = node[part]
+        else:
+            raise SceneError(source, here, f"is a value, not a table, so --set {item} cannot go inside it")
+    last = parts[-1]
+    if isinstance(node, list):
+        _list_item(node, last, ".".join(parts), source, item)
+        node[int(last)] = value
+    elif isinstance(node, dict):
+        node[last] = value
+    else:
+        raise SceneError(source, ".".join(parts[:-1]), f"is a value, not a table, so --set {item} cannot go "
+                                                       f"inside it")
+
+
+def _list_item(items: list, part: str, here: str, source: str, item: str):
+    if not part.isdigit():
+        raise SceneError(source, here, f"is a list; address its entries by number (e.g. {here}.0...) in "
+                                       f"--set {item}")
+    index = int(part)
+    if index == len(items):
+        items.append({})
+    if index > len(items):
+        raise SceneError(source, here, f"has {len(items)} entries; --set can change one of them or add entry "
+                                       f"{len(items)}")
+    return items[index]
+
+
+# ------------------------------------------------------------------------------------ validation
+
+
+def scene_from_dict(raw: dict, source: str = "<scene>", default_name: str = "scene") -> S.Scene:
+    """Validate a raw TOML dict into a :class:`Scene`; raises :class:`SceneError`."""
+    allowed = list(S.TOP_LEVEL_SCALARS) + list(S.TABLES) + list(S.ARRAYS_OF_TABLES)
+    for key in raw:
+        if key not in allowed:
+            raise SceneError(source, key, _unknown(key, allowed, "a top-level key or table"))
+    for key in S.REQUIRED_TABLES:
+        if key not in raw:
+            raise SceneError(source, key, f"missing: every scene needs a [{key}] table")
+
+    top = {}
+    for key, sp in S.TOP_LEVEL_SCALARS.items():
+        if key in raw:
+            top[key] = _value(raw[key], sp, key, source, dim=0)
+    dim = top.get("dimension", 2)
+    ctx = _Ctx(source, dim)
+
+    rope = ctx.table(raw, "rope", S.Rope)
+    parts: dict[str, Any] = {"rope": rope}
+    for key in ("gravity", "drag", "bending", "thrower", "pinned", "integrator", "output"):
+        if key in raw:
+            parts[key] = ctx.table(raw, key, S.TABLES[key])
+    for key, cls in S.ARRAYS_OF_TABLES.items():
+        if key in raw:
+            items = raw[key]
+            if isinstance(items, dict):
+                items = [items]
+            if not isinstance(items, list):
+                raise SceneError(source, key, f"must be an array of tables ([[{key}]]), got {_show(items)}")
+            parts[key] = tuple(ctx.table(items, i, cls, prefix=key) for i in range(len(items)))
+    parts["initial"] = ctx.initial(raw)
+
+    scene = S.Scene(
+        name=top.get("name", default_name),
+        description=top.get("description", ""),
+        dimension=dim,
+        **parts,
+    )
+    return _check_scene(scene, source)
+
+
+class _Ctx:
+    def __init__(self, source: str, dim: int):
+        self.source, self.dim = source, dim
+
+    def table(self, container, key, cls, prefix: str = ""):
+        path = f"{prefix}.{key}" if prefix else str(key)
+        raw = container[key]
+        if not isinstance(raw, dict):
+            raise SceneError(self.source, path, f"must be a table, got {_show(raw)}")
+        return self.build(raw, cls, path)
+
+    def build(self, raw: dict, cls, path: str, skip: tuple = ()):
+        specs = {f.name: f.metadata["spec"] for f in fields(cls) if "spec" in f.metadata}
+        for key in raw:
+            if key not in specs and key not in skip:
+                raise SceneError(self.source, f"{path}.{key}", _unknown(key, list(specs), f"a key of [{path}]"))
+        values = {}
+        for name, sp in specs.items():
+            if name in raw:
+                values[name] = _value(raw[name], sp, f"{path}.{name}", self.source, self.dim)
+            elif sp.required:
+                raise SceneError(self.source, f"{path}.{name}", f"missing: {sp.doc}{_unit(sp)}")
+        return cls(**values)
+
+    def initial(self, raw: dict):
+        init = raw["initial"]
+        if not isinstance(init, dict):
+            raise SceneError(self.source, "initial", f"must be a table, got {_show(init)}")
+        shape_spec = S.Spec("str", "initial shape", choices=tuple(S.INITIAL_SHAPES))
+        if "shape" not in init:
+            raise SceneError(self.source, "initial.shape", f"missing: one of {_choices(shape_spec.choices)}")
+        shape = _value(init["shape"], shape_spec, "initial.shape", self.source, self.dim)
+        start = self.build(init, S.INITIAL_SHAPES[shape], "initial", skip=("shape",))
+        zeros = (0.0,) * self.dim
+        if start.velocity is None:
+            start = replace(start, velocity=zeros)
+        if isinstance(start, S.HangingStart) and start.top is None:
+            start = replace(start, top=zeros)
+        return start
+
+
+def _check_scene(scene: S.Scene, source: str) -> S.Scene:
+    """Checks that involve more than one key."""
+    rope, n = scene.rope, scene.rope.nodes
+
+    def fail(key, message):
+        raise SceneError(source, key, message)
+
+    if rope.closed and n < 3:
+        fail("rope.nodes", f"a closed loop needs at least 3 nodes, got {n}")
+    if scene.bending is not None:
+        if rope.closed and n < 5:
+            fail("bending", f"bending springs on a loop need at least 5 nodes (with fewer, second neighbours "
+                            f"are also first neighbours), got {n}")
+        if not rope.closed and n < 3:
+            fail("bending", f"bending springs need at least 3 nodes on a line, got {n}")
+
+    def index(key, i):
+        if not -n <= i < n:
+            fail(key, f"node index {i} is past the rope's end: allowed -{n} to {n - 1}")
+        return i % n
+
+    held: dict[int, str] = {}
+    if scene.pinned is not None:
+        for j, i in enumerate(scene.pinned.nodes):
+            key = f"pinned.nodes[{j}]"
+            node = index(key, i)
+            if node in held:
+                fail(key, f"node {node} is listed twice (also {held[node]})")
+            held[node] = key
+    for g, drive in enumerate(scene.driven):
+        for j, i in enumerate(drive.nodes):
+            key = f"driven.{g}.nodes[{j}]"
+            node = index(key, i)
+            if node in held:
+                fail(key, f"node {node} is already held by {held[node]}; a node is pinned or driven, not both")
+            held[node] = key
+    if len(held) == n:
+        fail("pinned" if scene.pinned else "driven", "every node is held; at least one must be free to move")
+
+    seen: dict[int, str] = {}
+    for j, o in enumerate(scene.overrides):
+        key = f"overrides.{j}.index"
+        node = index(key, o.index)
+        if node in seen:
+            fail(key, f"node {node} is already overridden by {seen[node]}; give each node one entry")
+        seen[node] = f"overrides.{j}"
+        if o.mass is None and o.drag is None:
+            fail(f"overrides.{j}", "sets neither mass nor drag; give at least one")
+
+    init = scene.initial
+    if isinstance(init, (S.HangingStart, S.LineStart)) and rope.closed:
+        fail("initial.shape", f"'{init.shape}' makes an open line; a closed loop starts as 'square_loop' or "
+                              f"'points'")
+    if isinstance(init, S.SquareLoopStart):
+        if not rope.closed:
+            fail("initial.shape", "'square_loop' needs a closed loop (rope.closed = true)")
+        if init.top_center is None:
+            if scene.thrower is None:
+                fail("initial.top_center", "missing: needed when there is no [thrower] to centre the square on")
+            scene = replace(scene, initial=replace(init, top_center=scene.thrower.center))
+    if isinstance(init, S.PointsStart):
+        if len(init.points) != n:
+            fail("initial.points", f"has {len(init.points)} points but rope.nodes is {n}; give one per node")
+    if isinstance(init, S.LineStart) and init.start == init.end:
+        fail("initial.end", "equals initial.start; a line needs two distinct ends")
+    if isinstance(init, (S.PointsStart,)):
+        pts = init.points
+        pairs = [(i, i + 1) for i in range(n - 1)] + ([(n - 1, 0)] if rope.closed else [])
+        for i, j in pairs:
+            if pts[i] == pts[j]:
+                fail("initial.points", f"nodes {i} and {j} coincide; a spring between them has no direction")
+
+    if scene.thrower is not None and scene.thrower.omega0 is None:
+        scene = replace(scene, thrower=replace(scene.thrower, omega0=scene.thrower.resolved_omega0))
+    guides = []
+    for j, guide in enumerate(scene.guides):
+        if guide.omega0 is None:
+            if scene.thrower is None:
+                fail(f"guides.{j}.omega0", "missing: needed when there is no [thrower] to take it from")
+            guide = replace(guide, omega0=scene.thrower.omega0)
+        guides.append(guide)
+    scene = replace(scene, guides=tuple(guides))
+
+    out = scene.output
+    if out.interval < scene.integrator.dt:
+        fail("output.interval", f"must be at least integrator.dt = {scene.integrator.dt:g} s, got {out.interval:g}")
+    return scene
+
+
+# ------------------------------------------------------------------------------ single values
+
+
+def _value(value: Any, sp: S.Spec, key: str, source: str, dim: int):
+    def bad(what):
+        raise SceneError(source, key, f"{what}{_unit(sp)}, got {_show(value)}")
+
+    if sp.kind == "bool":
+        if not isinstance(value, bool):
+            bad("must be true or false")
+        return value
+    if sp.kind == "str":
+        if not isinstance(value, str):
+            bad(f"must be one of {_choices(sp.choices)}" if sp.choices else "must be a string")
+        if sp.choices and value not in sp.choices:
+            near = difflib.get_close_matches(value, sp.choices, n=1)
+            hint = f" (did you mean '{near[0]}'?)" if near else ""
+            raise SceneError(source, key, f"must be one of {_choices(sp.choices)}, got {_show(value)}{hint}")
+        return value
+    if sp.kind == "int":
+        if isinstance(value, bool) or not isinstance(value, int):
+            bad(f"must be one of {_choices(sp.choices)}" if sp.choices else f"must be {_range(sp, 'an integer')}")
+        if sp.choices and value not in sp.choices:
+            bad(f"must be one of {_choices(sp.choices)}")
+        _bounds(value, sp, key, source, "an integer")
+        return value
+    if sp.kind == "float":
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            bad(f"must be {_range(sp, 'a number')}")
+        value = float(value)
+        if not math.isfinite(value):
+            bad("must be a finite number")
+        _bounds(value, sp, key, source, "a number")
+        return value
+    if sp.kind == "vector":
+        return _vector(value, dim, key, source, sp)
+    if sp.kind == "int_list":
+        if isinstance(value, int) and not isinstance(value, bool):
+            value = [value]
+        if not isinstance(value, list) or not value or not all(
+                isinstance(v, int) and not isinstance(v, bool) for v in value):
+            bad("must be a non-empty list of node indices (integers)")
+        return tuple(value)
+    if sp.kind == "points":
+        if not isinstance(value, list) or not value:
+            bad(f"must be a list of points, each a list of {dim} numbers")
+        return tuple(_vector(p, dim, f"{key}[{i}]", source, sp) for i, p in enumerate(value))
+    raise AssertionError(sp.kind)
+
+
+def _vector(value, dim, key, source, sp):
+    ok = isinstance(value, list) and len(value) == dim and all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value)
+    if not ok:
+        raise SceneError(source, key, f"must be a list of {dim} finite numbers (dimension = {dim}){_unit(sp)}, "
+                                      f"got {_show(value)}")
+    return tuple(float(v) for v in value)
+
+
+def _bounds(value, sp: S.Spec, key, source, what):
+    low_ok = sp.low is None or (value > sp.low if sp.open_low else value >= sp.low)
+    high_ok = sp.high is None or value <= sp.high
+    if not (low_ok and high_ok):
+        raise SceneError(source, key, f"must be {_range(sp, what)}{_unit(sp)}, got {_show(value)}")
+
+
+def _range(sp: S.Spec, what: str) -> str:
+    parts = []
+    if sp.low is not None:
+        parts.append(f"{'>' if sp.open_low else '>='} {sp.low:g}")
+    if sp.high is not None:
+        parts.append(f"<= {sp.high:g}")
+    return f"{what} {' and '.join(parts)}" if parts else what
+
+
+def _unit(sp: S.Spec) -> str:
+    return f" [{sp.unit}]" if sp.unit else ""
+
+
+def _choices(choices) -> str:
+    return ", ".join(repr(c) if isinstance(c, str) else str(c) for c in choices)
+
+
+def _unknown(key: str, allowed: list[str], what: str) -> str:
+    near = difflib.get_close_matches(str(key), allowed, n=1, cutoff=0.6)
+    hint = f"did you mean '{near[0]}'? " if near else ""
+    return f"unknown key, not {what}; {hint}allowed: {', '.join(allowed)}"
+
+
+def _show(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."

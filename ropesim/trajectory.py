@@ -1,0 +1,202 @@
+"""The run folder on disk: ``trajectory.npz``, ``scene.toml`` and ``summary.json``.
+
+``trajectory.npz`` holds ``t`` (F,) [s], ``x`` (F, N, D) [m] and ``v`` (F, N, D) [m/s], every saved frame from
+t = 0. It is an ordinary uncompressed ``.npz`` (``numpy.load`` reads it), written so that each array can also be
+memory-mapped: :meth:`Trajectory.open` reads frames lazily, so a trajectory of any size can be analysed.
+
+Frames stream to memory-mapped ``.npy`` files in a hidden folder while the run goes on; the ``.npz`` is then
+assembled beside its final name and moved into place, so a reader never sees half a file.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+TRAJECTORY, SCENE, SUMMARY = "trajectory.npz", "scene.toml", "summary.json"
+ARRAYS = ("t", "x", "v")
+
+
+class RunFolderError(ValueError):
+    """A run folder that cannot be read; ``str()`` is one line for the user."""
+
+
+def write_text_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` via a temporary file in the same folder and an atomic rename."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def write_json_atomic(path: Path, data: dict) -> None:
+    write_text_atomic(path, json.dumps(data, indent=2, sort_keys=False) + "\n")
+
+
+def write_npz_atomic(path: Path, arrays: dict[str, np.ndarray]) -> None:
+    """Write an uncompressed, memory-mappable ``.npz`` atomically, streaming each array in chunks."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_STORED, allowZip64=True) as zf:
+            for name, arr in arrays.items():
+                with zf.open(f"{name}.npy", "w", force_zip64=True) as fh:
+                    np.lib.format.write_array(fh, np.asarray(arr), allow_pickle=False)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _memmap_npz(path: Path) -> dict[str, np.ndarray]:
+    """Memory-map every array of an uncompressed ``.npz`` (as ``write_npz_atomic`` makes them)."""
+    out = {}
+    with zipfile.ZipFile(path) as zf, open(path, "rb") as fh:
+        for info in zf.infolist():
+            name = info.filename.removesuffix(".npy")
+            if info.compress_type != zipfile.ZIP_STORED:
+                out[name] = np.load(zf.open(info.filename), allow_pickle=False)
+                continue
+            fh.seek(info.header_offset)
+            local = fh.read(30)
+            if local[:4] != b"PK\x03\x04":
+                raise RunFolderError(f"{path}: corrupt zip entry {info.filename}")
+            name_len = int.from_bytes(local[26:28], "little")
+            extra_len = int.from_bytes(local[28:30], "little")
+            fh.seek(info.header_offset + 30 + name_len + extra_len)
+            version = np.lib.format.read_magic(fh)
+            if version == (1, 0):
+                shape, fortran, dtype = np.lib.format.read_array_header_1_0(fh)
+            else:
+                shape, fortran, dtype = np.lib.format.read_array_header_2_0(fh)
+            offset = fh.tell()
+            if np.prod(shape) == 0:
+                out[name] = np.zeros(shape, dtype=dtype)
+            else:
+                out[name] = np.memmap(path, dtype=dtype, mode="r", offset=offset, shape=shape,
+                                      order="F" if fortran else "C")
+    return out
+
+
+class FrameStore:
+    """Where a run's saved frames go: memory for :func:`ropesim.simulate`, disk for a run folder."""
+
+    def __init__(self, n_frames: int, nodes: int, dim: int, folder: Path | None = None):
+        self.count = 0
+        self.folder = folder
+        shape = (n_frames, nodes, dim)
+        if folder is None:
+            self._tmp = None
+            self.t = np.zeros(n_frames)
+            self.x = np.zeros(shape)
+            self.v = np.zeros(shape)
+        else:
+            folder.mkdir(parents=True, exist_ok=True)
+            self._tmp = Path(tempfile.mkdtemp(prefix=".frames-", dir=folder))
+            open_mm = np.lib.format.open_memmap
+            self.t = open_mm(self._tmp / "t.npy", mode="w+", dtype=np.float64, shape=(n_frames,))
+            self.x = open_mm(self._tmp / "x.npy", mode="w+", dtype=np.float64, shape=shape)
+            self.v = open_mm(self._tmp / "v.npy", mode="w+", dtype=np.float64, shape=shape)
+
+    def append(self, t: np.ndarray, x_dn: np.ndarray, v_dn: np.ndarray) -> None:
+        """Append frames given in kernel layout (F, D, N)."""
+        k = len(t)
+        if k == 0:
+            return
+        end = self.count + k
+        self.t[self.count:end] = t
+        self.x[self.count:end] = np.swapaxes(x_dn, 1, 2)
+        self.v[self.count:end] = np.swapaxes(v_dn, 1, 2)
+        self.count = end
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        return {"t": self.t[:self.count], "x": self.x[:self.count], "v": self.v[:self.count]}
+
+    def finish(self) -> None:
+        """Write ``trajectory.npz`` (frames so far) atomically and drop the streaming files."""
+        if self.folder is None:
+            return
+        try:
+            write_npz_atomic(self.folder / TRAJECTORY, self.arrays())
+        finally:
+            self.discard()
+
+    def discard(self) -> None:
+        if self._tmp is not None:
+            for name in ARRAYS:
+                arr = getattr(self, name)
+                if isinstance(arr, np.memmap):
+                    arr._mmap.close()
+            shutil.rmtree(self._tmp, ignore_errors=True)
+            self._tmp = None
+
+
+@dataclass
+class Trajectory:
+    """Saved frames of one run: ``t`` (F,) [s], ``x`` and ``v`` (F, N, D) [m, m/s], with its scene and summary.
+
+    From :func:`ropesim.simulate` the arrays are in memory; from :meth:`open` they are memory-mapped.
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    v: np.ndarray
+    scene: object
+    summary: dict = field(default_factory=dict)
+    folder: Path | None = None
+
+    @property
+    def frames(self) -> int:
+        return len(self.t)
+
+    @property
+    def nodes(self) -> int:
+        return self.x.shape[1]
+
+    @classmethod
+    def open(cls, folder: str | Path) -> "Trajectory":
+        """Read a run folder lazily; raises :class:`RunFolderError` with one clear line if it is unusable."""
+        from .loader import SceneError, load_scene
+
+        folder = Path(folder)
+        if not folder.is_dir():
+            raise RunFolderError(f"{folder}: no such run folder (make one with `ropesim run SCENE.toml`)")
+        for name in (TRAJECTORY, SCENE):
+            if not (folder / name).is_file():
+                raise RunFolderError(f"{folder}: not a run folder: {name} is missing")
+        try:
+            scene = load_scene(folder / SCENE)
+        except SceneError as exc:
+            raise RunFolderError(f"{folder}: its scene.toml is not valid: {exc}") from None
+        try:
+            arrays = _memmap_npz(folder / TRAJECTORY)
+        except (zipfile.BadZipFile, ValueError, OSError, EOFError) as exc:
+            raise RunFolderError(f"{folder / TRAJECTORY}: corrupt or unreadable ({exc})") from None
+        missing = [a for a in ARRAYS if a not in arrays]
+        if missing:
+            raise RunFolderError(f"{folder / TRAJECTORY}: missing arrays {', '.join(missing)}")
+        t, x, v = arrays["t"], arrays["x"], arrays["v"]
+        n, d = scene.rope.nodes, scene.dimension
+        if t.ndim != 1 or x.shape != (len(t), n, d) or v.shape != x.shape or len(t) == 0:
+            raise RunFolderError(f"{folder / TRAJECTORY}: arrays do not match the scene: t {t.shape}, "
+                                 f"x {x.shape}, v {v.shape}, expected (F,), (F, {n}, {d})")
+        summary = {}
+        if (folder / SUMMARY).is_file():
+            try:
+                summary = json.loads((folder / SUMMARY).read_text(encoding="utf-8"))
+            except (ValueError, OSError):
+                summary = {}
+        return cls(t=t, x=x, v=v, scene=scene, summary=summary, folder=folder)
