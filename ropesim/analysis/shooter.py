@@ -1,3 +1,44 @@
-"""The string shooter's loop (placeholder under construction)."""
-def shooter_figures(model, t, x):
-    return {}
+"""The string shooter's loop: its inclination and how fast the string goes round.
+
+Inclination is the direction of the loop's centroid seen from the thrower's centre, measured from straight
+down, positive towards the throw (+x): 0 degrees is a loop hanging vertically below the thrower (the vacuum
+picture), 90 degrees a loop standing straight out in front of it (the in-air picture).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..build import Model
+
+AVERAGE_WINDOW_S = 1.0  # the mean inclination is over the last second (or the last 20 % of a shorter run)
+
+
+def loop_inclination(model: Model, x: np.ndarray) -> np.ndarray:
+    """Inclination [deg] of the loop for one frame (N, D) or many (F, N, D)."""
+    centre = np.asarray(model.scene.thrower.center)
+    d = np.asarray(x).mean(axis=-2) - centre
+    return np.degrees(np.arctan2(d[..., 0], -d[..., 1]))
+
+
+def circulation_speed(x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Mean speed [m/s] of the string along itself (positive from node i towards node i+1), per frame."""
+    x, v = np.asarray(x), np.asarray(v)
+    tangent = np.roll(x, -1, axis=-2) - np.roll(x, 1, axis=-2)
+    norm = np.linalg.norm(tangent, axis=-1, keepdims=True)
+    tangent = tangent / np.where(norm > 0, norm, 1.0)
+    return np.einsum("...nd,...nd->...", v, tangent) / x.shape[-2]
+
+
+def shooter_figures(model: Model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> dict:
+    """The shooter's summary: inclination at the end and averaged at the end, and the circulation speed."""
+    window = min(AVERAGE_WINDOW_S, 0.2 * float(t[-1]))
+    last = np.flatnonzero(t >= t[-1] - window)
+    incl = loop_inclination(model, x[last])
+    return {
+        "loop_inclination_deg": round(float(incl[-1]), 3),
+        "mean_loop_inclination_deg": round(float(incl.mean()), 3),
+        "averaged_over_s": round(float(t[-1] - t[last[0]]), 6),
+        "circulation_speed_m_s": round(float(circulation_speed(x[-1], v[-1])), 4),
+        "drive_speed_m_s": model.scene.thrower.v_max,
+    }

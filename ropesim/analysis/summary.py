@@ -67,5 +67,5 @@ def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray
         if scene.thrower is not None and scene.rope.closed:
             from .shooter import shooter_figures
 
-            summary["shooter"] = shooter_figures(model, t, x)
+            summary["shooter"] = shooter_figures(model, t, x, v)
     return summary
