@@ -57,15 +57,25 @@ def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray
         summary["dt_requested"] = grid.requested_dt
     finite = bool(np.all(np.isfinite(x[-1])) and np.all(np.isfinite(v[-1])))
     if finite:
-        energy = energy_terms(model, x[-1], v[-1])
-        summary["final_energy_J"] = {k: float(val) for k, val in energy.items()}
-        stretch, at = largest_stretch(model, x)
-        summary["max_spring_stretch"] = stretch
-        summary["max_spring_stretch_t"] = float(t[at])
-        if towed_end(scene) is not None:
-            summary["towed"] = towed_figures(model, x[-1])
-        if scene.thrower is not None and scene.rope.closed:
-            from .shooter import shooter_figures
-
-            summary["shooter"] = shooter_figures(model, t, x, v)
+        with np.errstate(over="ignore", invalid="ignore"):  # a run stopped by a blow-up may end huge
+            summary.update(_physics_figures(model, t, x, v))
     return summary
+
+
+def _physics_figures(model: Model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> dict:
+    """Energy, largest stretch, and the figures of the parts the scene declares (towed rope, shooter loop)."""
+    scene = model.scene
+    energy = energy_terms(model, x[-1], v[-1])
+    stretch, at = largest_stretch(model, x)
+    out: dict = {
+        "final_energy_J": {k: float(val) for k, val in energy.items()},
+        "max_spring_stretch": stretch,
+        "max_spring_stretch_t": float(t[at]),
+    }
+    if towed_end(scene) is not None:
+        out["towed"] = towed_figures(model, x[-1])
+    if scene.thrower is not None and scene.rope.closed:
+        from .shooter import shooter_figures
+
+        out["shooter"] = shooter_figures(model, t, x, v)
+    return out
