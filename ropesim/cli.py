@@ -87,6 +87,49 @@ def check(scene_file: SceneArg, sets: SetOpt = None) -> None:
     print_check(scene, scene_file)
 
 
+@app.command()
+def sweep(
+    scene_file: SceneArg,
+    sets: Annotated[Optional[list[str]], typer.Option(
+        "--set", "-s", metavar="KEY=VALUES",
+        help="A scene key and its values: a list 0.1,0.4,1.0, a range start:stop:count (inclusive, evenly "
+             "spaced; whole numbers for integer keys) or one value for every run; repeatable. Every "
+             "combination runs.")] = None,
+    jobs: Annotated[Optional[int], typer.Option("--jobs", "-j", help="Runs at once (default: one per core).",
+                                                show_default=False)] = None,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", "-o", help="Sweep folder: a run folder per combination and results.csv (default "
+                            "runs/sweep-<scene name>/).", show_default=False)] = None,
+    plots: Annotated[Optional[list[str]], typer.Option(
+        "--plot", metavar="FIGURE", help="Plot a results.csv column (e.g. shooter.mean_loop_inclination_deg) "
+                                         "against the first swept key, one line per value of the others; "
+                                         "repeatable.")] = None,
+    scheduler: Annotated[Optional[str], typer.Option(
+        "--scheduler", metavar="ADDRESS", help="Send the runs to this Dask scheduler (tcp://host:8786) "
+                                               "instead of local processes; needs ropesim[dask].")] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")] = False,
+) -> None:
+    """Run a scene for every combination of --set values, in parallel; rerun, it resumes.
+
+    Exits 3 if any run did not complete (each is recorded with its error in results.csv), 130 if interrupted.
+    """
+    from .sweep import SweepError, run_sweep
+
+    try:
+        result = run_sweep(scene_file, sets or [], out=out, jobs=jobs, scheduler=scheduler, plots=plots or [],
+                           quiet=quiet)
+    except SweepError as exc:
+        fail(str(exc))
+    if not quiet:
+        typer.echo(f"{result.csv_path}: {len(result.rows)} runs ({result.ran} run now, {result.skipped} kept)"
+                   + "".join(f"\n{path}" for path in result.plots))
+    if result.interrupted:
+        fail(f"sweep interrupted; rerun the same command to finish it ({result.csv_path})", EXIT_INTERRUPTED)
+    if result.failed:
+        fail(f"{len(result.failed)} of {len(result.rows)} runs did not complete; see the error column of "
+             f"{result.csv_path}", EXIT_BLEW_UP)
+
+
 def main() -> None:
     app()
 
