@@ -56,6 +56,9 @@ def run(
                                                 show_default=False)] = None,
     sets: SetOpt = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")] = False,
+    animate_: Annotated[bool, typer.Option("--animate", help="Then animate the run into RUN_FOLDER/animation.gif "
+                                                             "(more choices: `ropesim animate`).")] = False,
+    fps: FpsOpt = 25.0,
 ) -> None:
     """Run a scene and write trajectory.npz, scene.toml and summary.json into its run folder."""
     from .report import print_summary
@@ -76,6 +79,8 @@ def run(
         fail(f"{scene_file}: {summary['message']}; frames up to then are in {folder}", EXIT_BLEW_UP)
     if summary["status"] == INTERRUPTED:
         fail(f"{scene_file}: {summary['message']}; frames up to then are in {folder}", EXIT_INTERRUPTED)
+    if animate_:
+        _animate(folder, None, quiet, fps=fps)
 
 
 @app.command()
@@ -128,6 +133,130 @@ def sweep(
     if result.failed:
         fail(f"{len(result.failed)} of {len(result.rows)} runs did not complete; see the error column of "
              f"{result.csv_path}", EXIT_BLEW_UP)
+
+
+# ------------------------------------------------------------------------- pictures (ropesim.render)
+
+RunDirArg = Annotated[Path, typer.Argument(help="Run folder written by `ropesim run`, e.g. runs/helicopter_mass.",
+                                           show_default=False)]
+FollowOpt = Annotated[bool, typer.Option("--follow", help="View from the driven node (the helicopter): "
+                                                          "positions relative to it.")]
+ViewOpt = Annotated[Optional[str], typer.Option(
+    "--view", help="3-D scenes: the axes shown across and up: xy (side view, default), xz (from above), "
+                   "zy (from the front).", show_default=False)]
+
+
+def _check_fps(fps: float) -> float:
+    if not fps > 0:
+        fail(f"--fps {fps:g}: must be a positive number of frames per second")
+    return fps
+
+
+FpsOpt = Annotated[float, typer.Option(
+    "--fps", callback=_check_fps, help="Video frames per second, taken from the run's saved frames; a GIF "
+                                       "plays at the nearest 100/n (50, 33.3, 25, 20, ...).")]
+QuietOpt = Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")]
+
+
+def _picture(make):
+    """Call ``make()``; an unusable run folder or request, or an unwritable output, prints one line, exits 2."""
+    from .render import RenderError
+    from .trajectory import RunFolderError
+
+    try:
+        return make()
+    except (RunFolderError, RenderError) as exc:
+        fail(str(exc))
+    except OSError as exc:
+        fail(f"{exc.filename or 'output'}: cannot write ({exc.strerror or exc})")
+    except KeyboardInterrupt:
+        fail("interrupted; no picture written", EXIT_INTERRUPTED)
+
+
+def _animate(run_dir: Path, out: Optional[Path], quiet: bool, **options) -> None:
+    from .render.animate import animate as make
+    from .trajectory import Trajectory
+
+    target = out if out is not None else run_dir / "animation.gif"
+    note = (lambda message: typer.echo(f"ropesim: {message}", err=True))
+    result = _picture(lambda: make(Trajectory.open(run_dir), target, progress=not quiet and sys.stderr.isatty(),
+                                   note=note, **options))
+    if not quiet:
+        typer.echo(f"{result.path}: {result.frames} frames at {result.fps:.3g} fps, "
+                   f"{result.size[0]}x{result.size[1]} px")
+
+
+@app.command()
+def animate(
+    run_dir: RunDirArg,
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output file, .gif or .mp4 (default "
+                                                "RUN_DIR/animation.gif).", show_default=False)] = None,
+    fps: FpsOpt = 25.0,
+    speed: Annotated[float, typer.Option("--speed", help="Simulated seconds per second of video.")] = 1.0,
+    start: Annotated[Optional[float], typer.Option("--start", help="First time shown, in seconds (default: 0).",
+                                                   show_default=False)] = None,
+    end: Annotated[Optional[float], typer.Option("--end", help="Last time shown, in seconds (default: the run's end).",
+                                                 show_default=False)] = None,
+    follow: FollowOpt = False,
+    view: ViewOpt = None,
+    size: Annotated[int, typer.Option("--size", help="The picture's longer side, in pixels.")] = 640,
+    quiet: QuietOpt = False,
+) -> None:
+    """Animate a run folder as a GIF or an MP4 (by --out's extension), with the scene's geometry drawn."""
+    _animate(run_dir, out, quiet, fps=fps, speed=speed, start=start, end=end, follow=follow, view=view, size=size)
+
+
+@app.command()
+def frames(
+    run_dir: RunDirArg,
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output PNG (default RUN_DIR/frames.png).",
+                                                show_default=False)] = None,
+    times: Annotated[Optional[str], typer.Option("--times", help="Times to show in seconds, comma-separated, e.g. "
+                                                 "0,0.5,1,2,3 (the nearest saved frames).",
+                                                 show_default=False)] = None,
+    count: Annotated[Optional[int], typer.Option("--count", help="Or this many frames evenly spaced from start "
+                                                 "to end (default 6).", show_default=False)] = None,
+    overlay: Annotated[bool, typer.Option("--overlay", help="All frames on one view, fading from the first to "
+                                                            "the last, instead of side by side.")] = False,
+    follow: FollowOpt = False,
+    view: ViewOpt = None,
+    columns: Annotated[Optional[int], typer.Option("--columns", help="Panels per row.", show_default=False)] = None,
+    width: Annotated[Optional[int], typer.Option("--width", help="Picture width in pixels.", show_default=False)] = None,
+    quiet: QuietOpt = False,
+) -> None:
+    """One PNG of selected frames of a run, side by side or overlaid."""
+    from .render.frames import frame_sheet
+    from .render.timeline import parse_times
+    from .trajectory import Trajectory
+
+    target = out if out is not None else run_dir / "frames.png"
+    result = _picture(lambda: frame_sheet(
+        Trajectory.open(run_dir), target, times=None if times is None else parse_times(times), count=count,
+        overlay=overlay, follow=follow, view=view, columns=columns, width=width))
+    if not quiet:
+        typer.echo(f"{result.path}: t = {', '.join(f'{t:.3g}' for t in result.times)} s, "
+                   f"{result.size[0]}x{result.size[1]} px")
+
+
+@app.command()
+def plot(
+    run_dir: RunDirArg,
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output PNG (default RUN_DIR/plots.png).",
+                                                show_default=False)] = None,
+    quiet: QuietOpt = False,
+) -> None:
+    """Plot a run: energy and largest spring stretch over time, and the towed rope's angle or the shooter's loop.
+
+    A towed rope's angle is plotted along its length at the end, against the exact steady state; a string
+    shooter's loop inclination over time.
+    """
+    from .render.plots import plot_run
+    from .trajectory import Trajectory
+
+    target = out if out is not None else run_dir / "plots.png"
+    result = _picture(lambda: plot_run(Trajectory.open(run_dir), target))
+    if not quiet:
+        typer.echo(f"{result.path}: {', '.join(result.panels)}")
 
 
 def main() -> None:

@@ -1,0 +1,145 @@
+"""`ropesim animate`: a run folder's trajectory as a GIF or MP4, chosen by the output file's extension.
+
+The figure is laid out and drawn once (axes, ticks, the thrower box and guide circles, the legend); that
+background is saved, and each frame restores it and draws only the moving artists (the rope, its special
+nodes, the time stamp) with the Agg renderer, straight into an RGB array for the encoder. In a view that
+follows the driven node the fixed geometry moves too, so it is redrawn with the rope.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Iterable, Iterator
+
+import numpy as np
+
+from ..build import Model, build
+from ..trajectory import Trajectory
+from . import RenderError
+from .encode import ANIMATION_TYPES, GIF_MAX_FPS, gif_fps, write_gif, write_mp4
+from .framing import Projection, figure_inches, followed_nodes, origin, projection, single_view, view_box
+from .output import atomic_output, output_type
+from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
+from .timeline import animation_plan
+
+DPI = 100
+PALETTE_SAMPLES = 5  # frames, evenly spread, whose colours make a GIF's palette
+
+
+@dataclass(frozen=True)
+class Animation:
+    """What :func:`animate` wrote."""
+
+    path: Path
+    frames: int
+    fps: float
+    size: tuple[int, int]  # (width, height) [px]
+
+
+class FrameRenderer:
+    """Renders saved frame i of a trajectory to an RGBA array (H, W, 4) uint8, redrawing only what moves."""
+
+    def __init__(self, traj: Trajectory, model: Model, proj: Projection, nodes: np.ndarray | None, size: int):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        self.traj, self.nodes, self.cols = traj, nodes, list(proj.axes)
+        self.layout = layout = single_view(view_box(model, traj.x, proj, nodes), size,
+                                           legend=bool(legend_handles(model)))
+        self.size = (layout.width, layout.height)
+        fig = Figure(figsize=figure_inches(layout.width, layout.height, DPI), dpi=DPI)
+        self.canvas = FigureCanvasAgg(fig)
+        self.ax = ax = fig.add_axes(layout.axes_fraction)
+        follow = nodes is not None
+        style_axes(ax, proj, layout.box, follow)
+        picture_title(fig, model, proj)
+        self.geometry = Geometry(ax, model, proj, animated=follow)
+        self.rope = RopeArtist(ax, model, proj, animated=True)
+        # the time stamp, at the right of the title line: outside the view, so it never hides the rope
+        self.stamp = fig.text(1 - 6 / layout.width, 1 - 3 / layout.height, "", ha="right", va="top", fontsize=9,
+                              animated=True)
+        self.moving = (self.geometry.artists if follow else []) + self.rope.artists + [self.stamp]
+        self.canvas.draw()
+        self.background = self.canvas.copy_from_bbox(fig.bbox)
+
+    def render(self, i: int) -> np.ndarray:
+        x = np.asarray(self.traj.x[i])
+        offset = None
+        if self.nodes is not None:
+            offset = -origin(x, self.nodes)[self.cols]
+            self.geometry.move(offset)
+        self.canvas.restore_region(self.background)
+        self.rope.show(x, offset)
+        self.stamp.set_text(f"t = {self.traj.t[i]:.2f} s")
+        for artist in self.moving:
+            artist.draw(self.canvas.get_renderer())
+        return np.array(self.canvas.buffer_rgba())  # a plain copy: RGBA -> RGB is left to the encoder (in C)
+
+
+def picture_title(fig, model: Model, proj: Projection) -> None:
+    """The scene's name (and the view of a 3-D scene) at the top left, the legend on a line below it."""
+    parts = [model.scene.name]
+    if model.scene.dimension == 3:
+        parts.append(f"view {''.join(proj.names)}")
+    height = fig.bbox.height
+    fig.text(4 / fig.bbox.width, 1 - 3 / height, "  ·  ".join(parts), ha="left", va="top", fontsize=9,
+             fontweight="bold")
+    handles = legend_handles(model)
+    if handles:
+        fig.legend(handles=handles, loc="upper left", bbox_to_anchor=(0, 1 - 17 / height), ncol=len(handles),
+                   frameon=False, fontsize=7, handletextpad=0.2, columnspacing=1.0, borderaxespad=0.0,
+                   borderpad=0.2)
+
+
+def animate(traj: Trajectory, out: str | Path, *, fps: float = 25.0, speed: float = 1.0,
+            start: float | None = None, end: float | None = None, follow: bool = False, view: str | None = None,
+            size: int = 640, progress: bool = False, note: Callable[[str], None] | None = None) -> Animation:
+    """Write an animation of ``traj`` to ``out`` (.gif or .mp4) and say what was written.
+
+    fps: video frames per second; speed: simulated seconds per second of video; start/end: the time range
+    [s] (default the whole run); follow: the view from the driven node; view: the projection of a 3-D scene;
+    size: the picture's longer side [px]; note: receives one-line remarks (too few saved frames, GIF rate).
+    Raises :class:`ropesim.render.RenderError` for a request that cannot be met, before writing anything.
+    """
+    out = Path(out)
+    kind = output_type(out, ANIMATION_TYPES)
+    if size < 128:
+        raise RenderError(f"--size {size}: must be at least 128 px")
+    remarks = []
+    rate = fps
+    if kind == ".gif" and fps > 0:
+        rate = gif_fps(fps)
+        if fps > GIF_MAX_FPS:
+            remarks.append(f"a GIF plays at most {GIF_MAX_FPS:g} fps: using {rate:g} (write an .mp4 for more)")
+    plan = animation_plan(traj.t, rate, speed, start, end)
+    model = build(traj.scene)
+    proj = projection(view, traj.scene.dimension)
+    nodes = followed_nodes(model, follow)
+    if plan.note:
+        remarks.append(plan.note)
+    for remark in remarks:
+        if note is not None:
+            note(remark)
+    renderer = FrameRenderer(traj, model, proj, nodes, size)
+    frames = _tracked((renderer.render(i) for i in plan.indices), len(plan.indices), f"encoding {out.name}",
+                      progress)
+    with atomic_output(out) as tmp:
+        if kind == ".gif":
+            spread = plan.indices[np.linspace(0, len(plan.indices) - 1, PALETTE_SAMPLES).round().astype(int)]
+            write_gif(frames, tmp, plan.fps, [renderer.render(i) for i in spread])
+        else:
+            write_mp4(frames, tmp, plan.fps, renderer.size)
+    played = gif_fps(plan.fps) if kind == ".gif" else plan.fps
+    return Animation(path=out, frames=len(plan.indices), fps=played, size=renderer.size)
+
+
+def _tracked(frames: Iterable[np.ndarray], total: int, label: str, enabled: bool) -> Iterator[np.ndarray]:
+    """``frames`` with a rich progress bar on stderr when ``enabled``."""
+    if not enabled:
+        return iter(frames)
+    from rich.console import Console
+    from rich.progress import track
+
+    return iter(track(frames, total=total, description=label, console=Console(stderr=True), transient=True))
+

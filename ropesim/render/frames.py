@@ -1,0 +1,133 @@
+"""`ropesim frames`: one PNG of selected frames, side by side or overlaid with fading (the write-up's figures
+3-5 and 8-10).
+
+Every panel (or every overlaid rope) uses the same fixed limits, from the whole run, so shapes compare
+directly; in the overlay older frames are lighter and fainter, the last one solid.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import RenderError
+from ..build import build
+from ..trajectory import Trajectory
+from .framing import figure_inches, fit_box, followed_nodes, origin, projection, view_aspect, view_box
+from .output import atomic_output, output_type
+from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
+from .timeline import chosen_frames
+
+DPI = 100
+PANEL_SIDE = 300      # [px] default longer side of one side-by-side panel's view
+OVERLAY_SIDE = 600    # [px] default longer side of an overlay's view
+MAX_COLUMNS = 4
+MIN_WIDTH = 360       # [px] default pictures are at least this wide, so the title and legend fit
+TICK_ROOM = 50        # [px] per panel: its tick labels across
+TITLE_ROOM = 44       # [px] per panel row: its title and tick labels
+HEADER_ROOM = 40      # [px] the figure's title and legend
+FADE = (0.35, 1.0)    # colour-map position and opacity of the first and the last overlaid frame
+
+
+@dataclass(frozen=True)
+class Sheet:
+    """What :func:`frame_sheet` wrote."""
+
+    path: Path
+    times: tuple[float, ...]   # the saved times shown [s]
+    size: tuple[int, int]      # (width, height) [px]
+
+
+def default_columns(frames: int, aspect: float) -> int:
+    """Panels per row: up to 4 for tall views (the shooter's loop), 2 for wide ones (a towed rope in the lab),
+    spread evenly over the rows."""
+    most = MAX_COLUMNS if aspect > 1.2 else 3 if aspect > 0.6 else 2
+    return math.ceil(frames / math.ceil(frames / most))
+
+
+def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None = None, count: int | None = None,
+                overlay: bool = False, follow: bool = False, view: str | None = None, columns: int | None = None,
+                width: int | None = None) -> Sheet:
+    """Write a PNG of the frames nearest to ``times`` [s] (or ``count`` evenly spaced ones, default 6).
+
+    overlay: all frames on one view, fading from the first to the last; follow: the view from the driven
+    node; view: the projection of a 3-D scene; columns: panels per row; width: the picture's width [px].
+    """
+    out = Path(out)
+    output_type(out, (".png",))
+    indices = chosen_frames(traj.t, times, count)
+    if columns is not None and columns < 1:
+        raise RenderError(f"--columns {columns}: must be at least 1")
+    if width is not None and width < 200:
+        raise RenderError(f"--width {width}: must be at least 200 px")
+    model = build(traj.scene)
+    proj = projection(view, traj.scene.dimension)
+    nodes = followed_nodes(model, follow)
+    box = view_box(model, traj.x, proj, nodes)
+    aspect = view_aspect(box)
+    box = fit_box(box, 1.0, aspect)
+    frames = [np.asarray(traj.x[i]) for i in indices]
+    offsets = [None if nodes is None else -origin(x, nodes)[list(proj.axes)] for x in frames]
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    cols = 1 if overlay else (columns or default_columns(len(indices), aspect))
+    rows = math.ceil(len(indices) / cols) if not overlay else 1
+    side = OVERLAY_SIDE if overlay else PANEL_SIDE
+    px_width = width or cols * int(TICK_ROOM + side * min(1.0, 1.0 / aspect))
+    px_height = int(round(HEADER_ROOM + rows * ((px_width / cols - TICK_ROOM) * aspect + TITLE_ROOM)))
+    px_width = max(px_width, MIN_WIDTH)  # wider only: the views keep their size, centred
+    fig = Figure(figsize=figure_inches(px_width, px_height, DPI), dpi=DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(rows, cols, sharex=True, sharey=True, squeeze=False).ravel()
+    for ax in axes:
+        style_axes(ax, proj, box, nodes is not None)
+        ax.set_aspect("equal", adjustable="box")
+    shown = [float(traj.t[i]) for i in indices]
+    if overlay:
+        _overlay(axes[0], model, proj, frames, offsets, shown)
+    else:
+        for ax, x, offset, t in zip(axes, frames, offsets, shown):
+            geometry = Geometry(ax, model, proj)
+            if offset is not None:
+                geometry.move(offset)
+            RopeArtist(ax, model, proj).show(x, offset)
+            ax.set_title(f"t = {t:.2f} s", fontsize=9, pad=3)
+        for ax in axes[len(frames):]:
+            ax.set_visible(False)
+        fig.supxlabel(axes[0].get_xlabel(), fontsize=8)
+        fig.supylabel(axes[0].get_ylabel(), fontsize=8)
+        for ax in axes:
+            ax.label_outer()
+            ax.set_xlabel("")
+            ax.set_ylabel("")
+    header = model.scene.name + (f"  ·  view {''.join(proj.names)}" if traj.scene.dimension == 3 else "")
+    fig.suptitle(header, x=0.01, ha="left", fontsize=10, fontweight="bold")
+    handles = legend_handles(model)
+    if handles:
+        fig.legend(handles=handles, loc="outside lower center", ncol=len(handles), frameon=False, fontsize=7)
+    with atomic_output(out) as tmp:
+        fig.savefig(tmp, format="png", dpi=DPI)
+    return Sheet(path=out, times=tuple(shown), size=(px_width, px_height))
+
+
+def _overlay(ax, model, proj, frames, offsets, times) -> None:
+    """All ``frames`` on ``ax``, fading from light and faint (first) to dark and solid (last)."""
+    from matplotlib import colormaps
+    from matplotlib.lines import Line2D
+
+    cmap = colormaps["Blues"]
+    geometry = Geometry(ax, model, proj)
+    if offsets[-1] is not None:
+        geometry.move(offsets[-1])
+    fades = np.linspace(*FADE, len(frames)) if len(frames) > 1 else np.array([FADE[1]])
+    handles = []
+    for x, offset, t, f in zip(frames, offsets, times, fades):
+        color = cmap(f)
+        RopeArtist(ax, model, proj, alpha=float(f), color=color).show(x, offset)
+        handles.append(Line2D([], [], color=color, alpha=float(f), label=f"t = {t:.2f} s"))
+    ax.legend(handles=handles, fontsize=7, loc="best", framealpha=0.8)

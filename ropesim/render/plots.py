@@ -1,0 +1,169 @@
+"""`ropesim plot`: the figures a user wants from a run, one panel each, stacked in one PNG.
+
+Every run: the mechanical energy term by term [J], and the largest relative spring stretch |r| / l - 1 [%],
+over time. A towed rope (the helicopter scenes): the angle from vertical of every segment along the rope at
+the last frame, against the exact discrete steady state. A string shooter: the loop's inclination over time.
+Per-frame series are computed in blocks of frames, so a memory-mapped run of any length can be plotted.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from ..analysis.energy import energy_terms
+from ..analysis.towed import exact_steady_state, segment_angles, shape_verdict, towed_end
+from ..build import Model, build
+from ..forces.springs import pair_spring_stretch
+from ..trajectory import Trajectory
+from .framing import figure_inches, frame_blocks
+from .output import atomic_output, output_type
+
+DPI = 100
+WIDTH = 720          # [px]
+PANEL_HEIGHT = 250   # [px] per panel
+HEADER = 40          # [px] the title
+
+
+def per_frame(traj: Trajectory, fn: Callable[[np.ndarray, np.ndarray], np.ndarray | dict]):
+    """``fn(x, v)`` over blocks of frames ((B, N, D) each), joined along the frame axis (arrays or dicts)."""
+    parts = [fn(np.asarray(traj.x[sl]), np.asarray(traj.v[sl])) for sl in frame_blocks(traj.frames)]
+    if isinstance(parts[0], dict):
+        return {key: np.concatenate([p[key] for p in parts]) for key in parts[0]}
+    return np.concatenate(parts)
+
+
+def largest_stretch_series(traj: Trajectory, model: Model) -> np.ndarray:
+    """The largest relative stretch |r| / l - 1 of the rope's springs in each frame."""
+    rope = model.scene.rope
+    return per_frame(traj, lambda x, v: pair_spring_stretch(x, rope.segment_length, 1, rope.closed).max(axis=1))
+
+
+def last_finite_frame(traj: Trajectory) -> int:
+    """Index of the last frame whose positions are all finite (the last one, unless the run blew up)."""
+    for i in range(traj.frames - 1, -1, -1):
+        if np.all(np.isfinite(traj.x[i])):
+            return i
+    return 0
+
+
+# ------------------------------------------------------------------------------------------ panels
+
+
+def draw_energy(ax, traj: Trajectory, model: Model) -> None:
+    terms = per_frame(traj, lambda x, v: energy_terms(model, x, v))
+    for name, values in terms.items():
+        if name == "total":
+            ax.plot(traj.t, values, color="black", linewidth=1.8, label="total")
+        else:
+            ax.plot(traj.t, values, linewidth=1.1, label=name)
+    ax.set_ylabel("energy [J]")
+    ax.set_title("Mechanical energy (gravity: m g y, zero at y = 0)")
+    ax.legend(fontsize=7, ncol=len(terms), loc="best")
+
+
+def draw_stretch(ax, traj: Trajectory, model: Model) -> None:
+    stretch = 100 * largest_stretch_series(traj, model)
+    ax.plot(traj.t, stretch, color="#9467bd")
+    k = int(np.nanargmax(stretch))
+    ax.plot(traj.t[k], stretch[k], "o", color="#9467bd")
+    ax.axhline(0, color="0.6", linewidth=0.8)
+    ax.set_ylabel("largest stretch [%]")
+    ax.set_title(f"Largest spring stretch |r| / l - 1: {stretch[k]:.3g} % at t = {traj.t[k]:.3g} s")
+
+
+def draw_towed(ax, traj: Trajectory, model: Model) -> None:
+    """Segment angles from vertical, from the held end down, at the last frame and in the exact steady state."""
+    i = last_finite_frame(traj)
+    angles = segment_angles(model, np.asarray(traj.x[i]))
+    along = (np.arange(len(angles)) + 0.5) * model.scene.rope.segment_length
+    ax.plot(along, angles, "o-", markersize=3, label=f"simulated, t = {traj.t[i]:.3g} s")
+    title = f"Rope angle at t = {traj.t[i]:.3g} s: {shape_verdict(angles)}"
+    steady = exact_steady_state(model)
+    if steady is not None:
+        in_scene_order = steady if towed_end(model.scene) == 0 else steady[::-1]
+        exact = segment_angles(model, in_scene_order)
+        ax.plot(along, exact, "--", color="black", label="exact steady state")
+        title += f" (steady state: {shape_verdict(exact)})"
+    ax.set_xlabel("distance along the rope from the held end (at rest) [m]")
+    ax.set_ylabel("angle from vertical [deg]")
+    ax.set_title(title)
+    ax.legend(fontsize=7, loc="best")
+
+
+def draw_inclination(ax, traj: Trajectory, model: Model) -> None:
+    from ..analysis.shooter import loop_inclination, shooter_figures
+
+    inclination = per_frame(traj, lambda x, v: loop_inclination(model, x))
+    ax.plot(traj.t, inclination, color="#2ca02c")
+    figures = shooter_figures(model, traj.t, traj.x, traj.v)
+    t_end, window = float(traj.t[-1]), figures["averaged_over_s"]
+    ax.plot([t_end - window, t_end], [figures["mean_loop_inclination_deg"]] * 2, "--", color="black",
+            label=f"mean over the last {window:.3g} s: {figures['mean_loop_inclination_deg']:.1f} deg")
+    ax.axhline(0, color="0.6", linewidth=0.8)
+    ax.set_ylabel("inclination [deg]")
+    ax.set_title("Loop inclination: 0 = hanging below the thrower, 90 = straight out in front")
+    ax.legend(fontsize=7, loc="best")
+
+
+@dataclass(frozen=True)
+class Panel:
+    """One figure of the plot: its name, which scenes it is for, and how it is drawn."""
+
+    name: str
+    applies: Callable[[Model], bool]
+    draw: Callable  # (ax, traj, model) -> None
+    time_axis: bool = True
+
+
+PANELS = (
+    Panel("energy", lambda model: True, draw_energy),
+    # The energy ledger (issue 4: work done by drag, the driven nodes and the thrower box, which with the
+    # mechanical energy above adds up to a constant) belongs here, as its own Panel.
+    Panel("stretch", lambda model: True, draw_stretch),
+    Panel("towed", lambda model: towed_end(model.scene) is not None, draw_towed, time_axis=False),
+    Panel("shooter", lambda model: model.scene.thrower is not None and model.scene.rope.closed, draw_inclination),
+)
+
+
+@dataclass(frozen=True)
+class Plot:
+    """What :func:`plot_run` wrote."""
+
+    path: Path
+    panels: tuple[str, ...]
+    size: tuple[int, int]  # (width, height) [px]
+
+
+def plot_run(traj: Trajectory, out: str | Path) -> Plot:
+    """Write the run's figures (every :data:`PANELS` entry that applies to its scene) to the PNG ``out``."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    out = Path(out)
+    output_type(out, (".png",))
+    model = build(traj.scene)
+    panels = [p for p in PANELS if p.applies(model)]
+    height = HEADER + PANEL_HEIGHT * len(panels)
+    fig = Figure(figsize=figure_inches(WIDTH, height, DPI), dpi=DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
+    for ax, panel in zip(axes, panels):
+        panel.draw(ax, traj, model)
+        if panel.time_axis:
+            ax.set_xlabel("t [s]")
+            if traj.t[-1] > traj.t[0]:
+                ax.set_xlim(traj.t[0], traj.t[-1])
+        ax.grid(True, linewidth=0.4, alpha=0.5)
+        ax.title.set_fontsize(9)
+        ax.tick_params(labelsize=8)
+        ax.xaxis.label.set_fontsize(8)
+        ax.yaxis.label.set_fontsize(8)
+    title = traj.scene.name + (f": {traj.scene.description}" if traj.scene.description else "")
+    fig.suptitle(title, x=0.01, ha="left", fontsize=10, fontweight="bold", wrap=True)
+    with atomic_output(out) as tmp:
+        fig.savefig(tmp, format="png", dpi=DPI)
+    return Plot(path=out, panels=tuple(p.name for p in panels), size=(WIDTH, height))
