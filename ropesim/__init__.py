@@ -11,6 +11,10 @@ Heavy modules (numba, matplotlib) load only when first used, so the command line
 
 __version__ = "0.1.0"
 
+from .numba_cache import ensure_writable_cache  # noqa: E402
+
+ensure_writable_cache()  # before any kernel is defined: a read-only install caches its kernels elsewhere
+
 __all__ = ["load_scene", "scene_from_toml", "SceneError", "Scene", "simulate", "build", "Trajectory",
            "RunFolderError", "METHODS", "scene_to_toml"]
 
