@@ -1,21 +1,25 @@
-"""Time integrators: splitting schemes as data, run by one compiled loop.
+"""Time integrators, chosen by name: splitting schemes as data, a Butcher-table loop, and a stiff solver.
 
-A splitting (drift-kick) scheme advances one step h as
+Every method advances the state (x, v), each of shape (D, N), by uniform steps h, keeps held (pinned or driven)
+nodes exactly on x0 + V t at every stage, keeps its order with linear drag on, and books the energy ledger
+(see :mod:`ropesim.health`). :data:`METHODS` maps each name to its method; the name is the same in TOML
+(``integrator.method``), on the command line and here.
+
+Splitting (drift-kick) schemes advance one step h as
 
     drift(a_0 h), kick(b_0 h), drift(a_1 h), kick(b_1 h), ..., kick(b_{s-1} h), drift(a_s h)
 
 where drift(c) moves positions, x += c v, and kick(c) moves velocities under the forces at the current
 positions. Time advances in the drifts, so held nodes are put at x0 + V t with t the drift's end time and every
-force sees positions of one instant.
+force sees positions of one instant. Linear drag is integrated exactly within each kick: with gamma = b / m,
+the kick solves v' = a - gamma v for a time c, v <- e^(-gamma c) v + (1 - e^(-gamma c)) / gamma a. Putting
+-b v into a plain kick instead would drop every scheme to first order; done this way each keeps its order
+with drag on and drag never limits the time step. (The thrower's and guides' velocity-dependent forces stay
+in the plain kick: see the README's "Accuracy and stability" for what that does to the order.)
 
-Linear drag is integrated exactly within each kick: with gamma = b / m, the kick solves
-v' = a - gamma v for a time c, v <- e^(-gamma c) v + (1 - e^(-gamma c)) / gamma a. Putting -b v into a plain
-kick instead would drop every scheme to first order; done this way each keeps its order with drag on and
-drag never limits the time step.
-
-To add a scheme: give its coefficients, its order and a line of documentation in :data:`METHODS`; the
-stability interval is computed from the coefficients. The name is the same in TOML, on the command line and
-here.
+To add a method: give a splitting scheme's coefficients (or a Runge-Kutta method's Butcher table, see
+:mod:`ropesim.rk`), its order and a line of documentation, and list it in :data:`METHODS`; its stability
+interval is computed from the coefficients by :func:`stable_step`.
 """
 
 from __future__ import annotations
@@ -27,9 +31,8 @@ from functools import lru_cache
 import numpy as np
 from numba import njit
 
-from .kernel import accelerations
-
-OK, NON_FINITE = 0, 1
+from .health import BOX, DRAG, HELD, NON_FINITE, OK, end_step, held_power, place_held  # noqa: F401
+from .kernel import GUIDES, THROWER, accelerations, box_accelerations
 
 
 @dataclass(frozen=True)
@@ -41,6 +44,7 @@ class SplittingScheme:
     drift: tuple[float, ...]
     kick: tuple[float, ...]
     doc: str
+    kind: str = "splitting"
 
     @property
     def evaluations(self) -> int:
@@ -55,7 +59,50 @@ class SplittingScheme:
     @property
     def stability_limit(self) -> float:
         """Largest h omega for which the scheme stays bounded on a harmonic oscillator x'' = -omega^2 x."""
-        return _stability_limit(self.drift, self.kick)
+        return stable_step(self, 1.0)
+
+    def amplification(self, h: float, omega: float, gamma_force: float = 0.0, gamma_drag: float = 0.0):
+        """One step's 2x2 map of (x, v) for x'' = -omega^2 x - gamma_force x' - gamma_drag x'.
+
+        ``gamma_drag`` is integrated exactly in the kicks, like the scene's drag; ``gamma_force`` is a
+        velocity-dependent force evaluated in the kick (the thrower's and guides' damping).
+        """
+        m = np.eye(2)
+        for k, c in enumerate(self.kick):
+            m = np.array([[1.0, self.drift[k] * h], [0.0, 1.0]]) @ m
+            ch = c * h
+            decay = math.exp(-gamma_drag * ch)
+            gain = -math.expm1(-gamma_drag * ch) / gamma_drag if gamma_drag > 0 else ch
+            m = np.array([[1.0, 0.0], [-gain * omega * omega, decay - gain * gamma_force]]) @ m
+        return np.array([[1.0, self.drift[-1] * h], [0.0, 1.0]]) @ m
+
+
+def _stable(method, h: float, omega: float, gamma_force: float, gamma_drag: float) -> bool:
+    m = method.amplification(h, omega, gamma_force, gamma_drag)
+    return bool(np.max(np.abs(np.linalg.eigvals(m))) <= 1.0 + 1e-9)
+
+
+@lru_cache(maxsize=4096)
+def stable_step(method, omega: float, gamma_force: float = 0.0, gamma_drag: float = 0.0) -> float:
+    """Largest step h [s] for which ``method`` stays bounded on x'' = -omega^2 x - (gamma_force + gamma_drag) x'.
+
+    ``gamma_force`` [1/s] is damping the method evaluates explicitly (the thrower's and guides'), ``gamma_drag``
+    [1/s] the scene's linear drag (exact inside the splitting schemes' kicks, explicit in Runge-Kutta).
+    Infinite for an unconditionally stable method or when nothing oscillates or damps.
+    """
+    if getattr(method, "unconditionally_stable", False):
+        return math.inf
+    rate = max(omega, gamma_force + (gamma_drag if method.kind == "rk" else 0.0))
+    if rate <= 0.0:
+        return math.inf
+    h, factor = 1e-3 / rate, 1.01
+    while h * rate < 20.0 and _stable(method, h * factor, omega, gamma_force, gamma_drag):
+        h *= factor
+    lo, hi = h, h * factor
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if _stable(method, mid, omega, gamma_force, gamma_drag) else (lo, mid)
+    return lo
 
 
 def _yoshida4() -> SplittingScheme:
@@ -75,8 +122,11 @@ def _pefrl() -> SplittingScheme:
         "evaluations per step, a wider stability interval and a far smaller error constant than Yoshida-4.")
 
 
-METHODS: dict[str, SplittingScheme] = {
-    s.name: s for s in (
+def _methods() -> dict:
+    from .implicit import SDIRK2
+    from .rk import RK4
+
+    schemes = (
         SplittingScheme("symplectic_euler", 1, (0.0, 1.0), (1.0,),
                         "Symplectic Euler, the write-up's method: kick with the forces at x_n, then drift with "
                         "the new velocity. First order, 1 force evaluation per step."),
@@ -85,76 +135,62 @@ METHODS: dict[str, SplittingScheme] = {
                         "(the last kick's forces are reused by the next step's first)."),
         _yoshida4(),
         _pefrl(),
+        RK4,
+        SDIRK2,
     )
-}
+    return {s.name: s for s in schemes}
 
 
-def get_method(name: str) -> SplittingScheme:
+METHODS: dict = _methods()
+
+
+def get_method(name: str):
     try:
         return METHODS[name]
     except KeyError:
         raise ValueError(f"unknown integrator {name!r}: allowed {', '.join(METHODS)}") from None
 
 
-@lru_cache(maxsize=None)
-def _stability_limit(drift: tuple, kick: tuple) -> float:
-    def growth(hw: float) -> float:
-        m = np.eye(2)
-        for k in range(len(kick)):
-            m = np.array([[1.0, drift[k]], [0.0, 1.0]]) @ m       # (x, v) with h = 1, omega = hw
-            m = np.array([[1.0, 0.0], [-kick[k] * hw * hw, 1.0]]) @ m
-        m = np.array([[1.0, drift[-1]], [0.0, 1.0]]) @ m
-        return float(np.max(np.abs(np.linalg.eigvals(m))))
-
-    step, hw = 1e-3, 1e-3
-    while hw < 10.0 and growth(hw + step) <= 1.0 + 1e-9:
-        hw += step
-    lo, hi = hw, hw + step
-    for _ in range(40):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if growth(mid) <= 1.0 + 1e-9 else (lo, mid)
-    return lo
-
-
 def kick_factors(scheme: SplittingScheme, h: float, drag: np.ndarray, mass: np.ndarray,
-                 held: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per kick and node, the factors of the exact drag kick v <- decay v + gain a.
+                 held: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per kick and node, the factors of the exact drag kick v <- decay v + gain a, and its ``travel``.
 
     decay = e^(-gamma c h), gain = (1 - decay) / gamma (or c h without drag), with gamma = b / m and c the
-    kick coefficient. Held nodes get decay 1 and gain 0: their velocity never changes.
+    kick coefficient. Over the kick the node travels (the integral of v) gain v + travel a, with
+    travel = (c h - gain) / gamma (c^2 h^2 / 2 without drag); the ledger uses it to book the work of the
+    forces and the drag loss exactly. Held nodes get decay 1, gain 0 and travel 0: their velocity never
+    changes.
     """
     c = np.asarray(scheme.kick)[:, None] * h
-    gamma = (drag / mass)[None, :]
-    decay = np.exp(-gamma * c)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        gain = np.where(gamma > 0, -np.expm1(-gamma * c) / np.where(gamma > 0, gamma, 1.0), c)
+    gamma = np.broadcast_to((drag / mass)[None, :], (len(scheme.kick), len(mass)))
+    z = gamma * c
+    decay = np.exp(-z)
+    safe = np.where(gamma > 0, gamma, 1.0)
+    gain = np.where(gamma > 0, -np.expm1(-z) / safe, c)
+    small = np.abs(z) < 1e-3
+    series = c * c * (0.5 - z / 6.0 + z * z / 24.0 - z ** 3 / 120.0)  # (z + expm1(-z)) c^2 / z^2 for small z
+    travel = np.where(small, series, (z + np.expm1(-z)) / (safe * safe))
     decay[:, held] = 1.0
     gain[:, held] = 0.0
-    return np.ascontiguousarray(decay), np.ascontiguousarray(gain)
+    travel[:, held] = 0.0
+    return np.ascontiguousarray(decay), np.ascontiguousarray(gain), np.ascontiguousarray(travel)
 
 
 @njit(cache=True, error_model="numpy")
-def _first_non_finite(x):
-    dim, n = x.shape
-    for i in range(n):
-        for d in range(dim):
-            if not math.isfinite(x[d, i]):
-                return i
-    return -1
+def advance(x, v, acc, acc_box, have_acc, ledger, step0, n_steps, total_steps, h, drift, kick, decay, gain, travel,
+            reuse_force, held, mass, forces, limits, save_every, frames, check_every):
+    """Advance ``n_steps`` splitting steps in place, from global step ``step0`` (time step0 * h).
 
-
-@njit(cache=True, error_model="numpy")
-def advance(x, v, acc, have_acc, step0, n_steps, total_steps, h, drift, kick, decay, gain, reuse_force,
-            held_idx, held_x0, held_v, forces, save_every, frames_t, frames_x, frames_v, check_every):
-    """Advance ``n_steps`` steps in place, from global step ``step0`` (time step0 * h).
-
-    Saves a frame after every global step s (1-based) with s % save_every == 0 or s == total_steps, into
-    ``frames_*`` (F, D, N). ``have_acc[0]`` carries the first-same-as-last forces between calls.
-    Returns (steps done, frames written, status, node): status NON_FINITE names the first non-finite node.
+    ``held`` = (indices, x0 (D, H), V (D, H)); ``frames`` = (t (F,), x (F, D, N), v (F, D, N), ledger (F, 3)).
+    Saves a frame after every global step s (1-based) with s % save_every == 0 or s == total_steps.
+    ``have_acc[0]`` carries the first-same-as-last forces between calls. Returns (steps done, frames written,
+    status, node): see :func:`ropesim.health.check_health`.
     """
     dim, n = x.shape
     stages = kick.shape[0]
-    n_held = held_idx.shape[0]
+    held_idx, held_x0, held_v = held
+    flags = forces[1]
+    has_box = flags[THROWER] != 0 or flags[GUIDES] != 0
     frame = 0
     for s in range(n_steps):
         step = step0 + s
@@ -167,31 +203,40 @@ def advance(x, v, acc, have_acc, step0, n_steps, total_steps, h, drift, kick, de
                     for i in range(n):
                         x[d, i] += ch * v[d, i]
                 t += ch
-                for j in range(n_held):
-                    i = held_idx[j]
-                    for d in range(dim):
-                        x[d, i] = held_x0[d, j] + held_v[d, j] * t
+                place_held(x, held_idx, held_x0, held_v, t)
             if k == stages:
                 break
             if not (k == 0 and reuse_force and have_acc[0]):
                 accelerations(x, v, acc, forces)
+            if has_box:
+                box_accelerations(x, v, acc_box, forces)
             dk = decay[k]
             gk = gain[k]
+            qk = travel[k]
+            lost = 0.0
+            box = 0.0
             for d in range(dim):
                 for i in range(n):
-                    v[d, i] = dk[i] * v[d, i] + gk[i] * acc[d, i]
+                    vo = v[d, i]
+                    a = acc[d, i]
+                    vn = dk[i] * vo + gk[i] * a
+                    v[d, i] = vn
+                    way = gk[i] * vo + qk[i] * a
+                    lost += mass[i] * (a * way - 0.5 * (vn * vn - vo * vo))
+                    if has_box:
+                        box += mass[i] * acc_box[d, i] * way
+            ch = kick[k] * h
+            ledger[DRAG] += lost
+            ledger[HELD] += ch * held_power(acc, mass, held_idx, held_v)
+            if has_box:
+                for j in range(held_idx.shape[0]):
+                    i = held_idx[j]
+                    for d in range(dim):
+                        box += ch * mass[i] * acc_box[d, i] * held_v[d, j]
+                ledger[BOX] += box
         have_acc[0] = reuse_force
-        done = step + 1
-        saving = done % save_every == 0 or done == total_steps
-        if saving or done % check_every == 0:
-            bad = _first_non_finite(x)
-            if bad < 0:
-                bad = _first_non_finite(v)
-            if bad >= 0:
-                return s + 1, frame, NON_FINITE, bad
-        if saving:
-            frames_t[frame] = done * h
-            frames_x[frame] = x
-            frames_v[frame] = v
-            frame += 1
+        status, node, frame = end_step(step + 1, total_steps, save_every, check_every, h, x, v, mass, forces, ledger,
+                                       limits, frames, frame)
+        if status != OK:
+            return s + 1, frame, status, node
     return n_steps, frame, OK, -1

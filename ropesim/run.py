@@ -18,8 +18,9 @@ from typing import Callable
 
 import numpy as np
 
-from .build import Model, build, stability_frequency
-from .integrators import NON_FINITE, advance, get_method, kick_factors
+from .build import Model, build
+from .health import NEWTON_FAILED, NON_FINITE, OK, OVERSTRETCH, RUNAWAY_ENERGY
+from .integrators import advance, get_method, kick_factors
 from .scene import Scene
 
 COMPLETED, INTERRUPTED, BLEW_UP = "completed", "interrupted", "blew_up"
@@ -43,7 +44,8 @@ class TimeGrid:
         dt, t_end = scene.integrator.dt, scene.integrator.t_end
         steps = math.ceil(t_end / dt * (1 - 1e-12)) if t_end > 0 else 0
         h = t_end / steps if steps else dt
-        save_every = max(1, round(scene.output.interval / h))
+        # at most every step count: an interval past t_end saves t = 0 and t_end alone (and never overflows)
+        save_every = max(1, round(min(scene.output.interval / h, max(steps, 1))))
         return cls(dt=h, steps=steps, save_every=save_every, requested_dt=dt)
 
     @property
@@ -57,24 +59,66 @@ class TimeGrid:
 
 
 class Stepper:
-    """The scene's state and the compiled step loop; ``advance(n)`` moves it n steps forward."""
+    """The scene's state and the compiled step loop of its method; ``advance(n)`` moves it n steps forward.
+
+    Besides x and v it carries the energy ledger (``ledger``: drag loss, work of held nodes, work of the box
+    and guides, initial energy, energy scale; see :mod:`ropesim.health`) and, for the stiff integrator, the
+    Newton iterations so far (``stats``).
+    """
 
     def __init__(self, model: Model, method: str, grid: TimeGrid):
+        from .analysis.energy import energy_terms
+        from .health import E0, LEDGER_SIZE, SCALE
+
         self.model, self.grid = model, grid
         self.scheme = get_method(method)
         self.x = model.x0.copy()
         self.v = model.v0.copy()
         self.acc = np.zeros_like(self.x)
+        self.acc_box = np.zeros_like(self.x)
         self.have_acc = np.zeros(1, dtype=np.bool_)
+        self.stats = np.zeros(1, dtype=np.int64)
         self.step = 0
-        self.reuse_force = self.scheme.reuses_last_force and not model.velocity_dependent
-        self.drift = np.array(self.scheme.drift)
-        self.kick = np.array(self.scheme.kick)
-        self.decay, self.gain = kick_factors(self.scheme, grid.dt, model.drag, model.mass, model.held)
+        self.ledger = np.zeros(LEDGER_SIZE)
+        self.ledger[E0] = float(energy_terms(model, self.x.T, self.v.T)["total"])
+        self.ledger[SCALE] = energy_scale(model)
+        self.limits = np.array([stretch_limit(model), RUNAWAY_FACTOR])
+        self.held = (model.held_idx, model.held_x0, model.held_v)
+        kind = self.scheme.kind
+        if kind == "splitting":
+            self.reuse_force = self.scheme.reuses_last_force and not model.velocity_dependent
+            self.drift = np.array(self.scheme.drift)
+            self.kick = np.array(self.scheme.kick)
+            self.decay, self.gain, self.travel = kick_factors(self.scheme, grid.dt, model.drag, model.mass,
+                                                              model.held)
+        elif kind == "rk":
+            self.tables = self.scheme.tables()
+            stages = len(self.scheme.b)
+            self.xs, self.vs = np.zeros_like(self.x), np.zeros_like(self.x)
+            self.kx = np.zeros((stages,) + self.x.shape)
+            self.kv = np.zeros((stages,) + self.x.shape)
+            self.gamma = np.where(model.held, 0.0, model.drag / model.mass)
+        else:
+            from .implicit import NEWTON_TOL, band_width, scratch
+
+            scene = model.scene
+            bending = scene.bending is not None
+            self.band_w, self.cyclic = band_width(scene.rope.closed, model.nodes, bending)
+            self.work = scratch(model.dim, model.nodes, bending, scene.rope.closed)
+            self.free = ~model.held
+            self.newton_tol = NEWTON_TOL * scene.rope.segment_length
+            self.drag = np.where(model.held, 0.0, model.drag)
 
     @property
     def t(self) -> float:
         return self.step * self.grid.dt
+
+    @property
+    def force_evaluations(self) -> int:
+        """Force evaluations so far (for the stiff integrator, its Newton iterations)."""
+        if self.scheme.kind == "implicit":
+            return int(self.stats[0])
+        return self.step * self.scheme.evaluations
 
     def frames_in(self, n: int) -> int:
         """Frames saved by the next ``n`` steps."""
@@ -84,17 +128,40 @@ class Stepper:
             count += 1
         return count
 
-    def advance(self, n: int, frames: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None):
+    def new_frames(self, n: int) -> tuple:
+        """Empty frame buffers (t, x, v, ledger) for the next ``n`` steps."""
+        from .health import LEDGER_COLUMNS
+
+        k = self.frames_in(n)
+        dim, nodes = self.x.shape
+        return (np.zeros(k), np.zeros((k, dim, nodes)), np.zeros((k, dim, nodes)), np.zeros((k, len(LEDGER_COLUMNS))))
+
+    def advance(self, n: int, frames: tuple | None = None):
         """Run ``n`` steps; returns (steps done, frames written, status, node)."""
         if frames is None:
-            k = self.frames_in(n)
-            dim, nodes = self.x.shape
-            frames = (np.zeros(k), np.zeros((k, dim, nodes)), np.zeros((k, dim, nodes)))
-        m = self.model
-        done, written, status, node = advance(
-            self.x, self.v, self.acc, self.have_acc, self.step, n, self.grid.steps, self.grid.dt, self.drift,
-            self.kick, self.decay, self.gain, self.reuse_force, m.held_idx, m.held_x0, m.held_v, m.forces,
-            self.grid.save_every, frames[0], frames[1], frames[2], CHECK_EVERY)
+            frames = self.new_frames(n)
+        m, g = self.model, self.grid
+        kind = self.scheme.kind
+        if kind == "splitting":
+            done, written, status, node = advance(
+                self.x, self.v, self.acc, self.acc_box, self.have_acc, self.ledger, self.step, n, g.steps, g.dt,
+                self.drift, self.kick, self.decay, self.gain, self.travel, self.reuse_force, self.held, m.mass,
+                m.forces, self.limits, g.save_every, frames, CHECK_EVERY)
+        elif kind == "rk":
+            from .rk import advance_rk
+
+            a, b, c = self.tables
+            done, written, status, node = advance_rk(
+                self.x, self.v, self.xs, self.vs, self.kx, self.kv, self.acc, self.acc_box, self.ledger, self.step,
+                n, g.steps, g.dt, a, b, c, self.gamma, self.held, m.mass, m.forces, self.limits, g.save_every,
+                frames, CHECK_EVERY)
+        else:
+            from .implicit import advance_sdirk
+
+            done, written, status, node = advance_sdirk(
+                self.x, self.v, self.acc, self.acc_box, self.ledger, self.stats, self.step, n, g.steps, g.dt,
+                self.band_w, self.cyclic, self.newton_tol, self.held, self.free, m.mass, self.drag, m.forces,
+                self.limits, g.save_every, frames, CHECK_EVERY, self.work)
         self.step += done
         return done, written, status, node
 
@@ -103,6 +170,40 @@ class Stepper:
         start = time.perf_counter()
         self.advance(0)
         return time.perf_counter() - start
+
+
+RUNAWAY_FACTOR = 10.0     # energy balance residual, in units of the energy scale, that counts as a blow-up
+STRETCH_SANITY = 10.0     # a spring longer than this many rest lengths (or 10x its static strain) is a blow-up
+
+
+def energy_scale(model: Model) -> float:
+    """The energy scale [J] a blow-up is measured against (before the flows are added, see health.py).
+
+    Initial kinetic and elastic energy, plus the rope's weight times its length (what gravity can convert),
+    plus every spring stretched by 1 % (so a rope at rest in zero gravity still has a scale).
+    """
+    from .analysis.energy import energy_terms
+
+    scene, rope = model.scene, model.scene.rope
+    g = scene.gravity.g if scene.gravity is not None else 0.0
+    terms = energy_terms(model, model.x0.T, model.v0.T)
+    moving = float(terms["total"] - terms.get("gravity", 0.0))
+    length = rope.nodes * rope.segment_length
+    springs = rope.nodes
+    return abs(moving) + float(model.mass.sum()) * g * length + springs * 0.5 * rope.stiffness * (
+        0.01 * rope.segment_length) ** 2
+
+
+def stretch_limit(model: Model) -> float:
+    """Largest sane spring length / rest length: 10, or 10 times the strain the rope's whole load would cause."""
+    scene, rope = model.scene, model.scene.rope
+    g = scene.gravity.g if scene.gravity is not None else 0.0
+    load = float(model.mass.sum()) * g
+    if model.held_v.size:
+        load += float(model.drag.sum()) * float(np.abs(model.held_v).max())
+    if scene.thrower is not None:
+        load += rope.nodes * scene.thrower.b_thrower * abs(scene.thrower.v_max)
+    return max(STRETCH_SANITY, 1.0 + STRETCH_SANITY * load / (rope.stiffness * rope.segment_length))
 
 
 @dataclass
@@ -118,6 +219,9 @@ class RunOutcome:
     message: str = ""
     bad_node: int = -1
     stable_dt: float | None = None
+    ledger: np.ndarray | None = None       # (F, 3) cumulative drag loss, held-node work, box work [J] per frame
+    energy0: float = 0.0                   # mechanical energy at t = 0 [J]
+    force_evaluations: int = 0
 
 
 @contextmanager
@@ -140,29 +244,28 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
     """Step ``model`` from t = 0 to t_end, appending saved frames to ``store`` (see :class:`FrameStore`)."""
     scene = model.scene
     grid = TimeGrid.of(scene)
-    stepper = Stepper(model, scene.integrator.method, grid)
-    compile_time = stepper.warm_up()
-    dim, nodes = stepper.x.shape
-    store.append(np.zeros(1), stepper.x[None], stepper.v[None])
-
-    status, bad_node, message = "completed", -1, ""
-    chunk = max(1, min(grid.steps, 20_000_000 // max(1, nodes * stepper.scheme.evaluations)))
-    chunk = _round_to(chunk, grid.save_every)
-    start = time.perf_counter()
-    with _interrupt_flag() as interrupted:
+    with _interrupt_flag() as interrupted:  # a Ctrl-C while compiling stops the run cleanly at t = 0
+        stepper = Stepper(model, scene.integrator.method, grid)
+        store.append(np.zeros(1), stepper.x[None], stepper.v[None])
+        ledger = [np.zeros((1, 3))]
+        status, bad_node, message, code = "completed", -1, "", OK
+        chunk = max(1, min(grid.steps, 20_000_000 // max(1, model.nodes * stepper.scheme.evaluations)))
+        chunk = _round_to(chunk, grid.save_every)
+        compile_time = stepper.warm_up()
+        start = time.perf_counter()
         while stepper.step < grid.steps:
             if interrupted.is_set() or (stop is not None and stop()):
                 status = INTERRUPTED
                 message = f"interrupted at t = {stepper.t:.6g} s (step {stepper.step} of {grid.steps})"
                 break
             n = min(chunk, grid.steps - stepper.step)
-            k = stepper.frames_in(n)
-            frames = (np.zeros(k), np.zeros((k, dim, nodes)), np.zeros((k, dim, nodes)))
+            frames = stepper.new_frames(n)
             tick = time.perf_counter()
             done, written, code, node = stepper.advance(n, frames)
             elapsed = time.perf_counter() - tick
             store.append(frames[0][:written], frames[1][:written], frames[2][:written])
-            if code == NON_FINITE:
+            ledger.append(frames[3][:written])
+            if code != OK:
                 status, bad_node = BLEW_UP, node
                 break
             if on_progress is not None:
@@ -174,14 +277,36 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
 
     stable_dt = None
     if status == BLEW_UP:
-        omega = stability_frequency(model)
-        limit = stepper.scheme.stability_limit
-        stable_dt = 0.5 * limit / omega if omega > 0 else None
-        hint = f"; a time step of {stable_dt:.3g} s or less would be stable" if stable_dt else ""
-        message = (f"blew up at t = {stepper.t:.6g} s (step {stepper.step}): node {bad_node} has a non-finite "
-                   f"position or velocity with dt = {grid.dt:.3g} s and method {scene.integrator.method}{hint}")
+        stable_dt, message = _blow_up_message(model, stepper, code, bad_node)
+    from .health import E0
+
     return RunOutcome(status=status, steps=stepper.step, t_reached=stepper.t, wall_time=wall,
-                      compile_time=compile_time, grid=grid, message=message, bad_node=bad_node, stable_dt=stable_dt)
+                      compile_time=compile_time, grid=grid, message=message, bad_node=bad_node, stable_dt=stable_dt,
+                      ledger=np.concatenate(ledger), energy0=float(stepper.ledger[E0]),
+                      force_evaluations=stepper.force_evaluations)
+
+
+def _blow_up_message(model: Model, stepper: Stepper, code: int, node: int) -> tuple[float | None, str]:
+    """(a time step that would be stable, one line saying when, where and how the run blew up)."""
+    from .analysis.stability import predicted_dt
+
+    scene, grid = model.scene, stepper.grid
+    method = scene.integrator.method
+    what = {
+        NON_FINITE: f"node {node} has a non-finite position or velocity",
+        OVERSTRETCH: f"the spring after node {node} is stretched beyond {stepper.limits[0]:.3g} times its rest "
+                     f"length",
+        RUNAWAY_ENERGY: f"runaway energy (the energy balance is off by more than {RUNAWAY_FACTOR:g} times the "
+                        f"energy in play; node {node} is the fastest)",
+        NEWTON_FAILED: f"the implicit stage's Newton solve did not converge in node {node}'s neighbourhood",
+    }[code]
+    bound = predicted_dt(model, method)
+    if np.isfinite(bound) and bound > 0 and grid.dt > 0.5 * bound:
+        stable_dt = 0.5 * bound
+    else:
+        stable_dt = 0.25 * grid.dt
+    return stable_dt, (f"blew up at t = {stepper.t:.6g} s (step {stepper.step}): {what}, with dt = {grid.dt:.3g} s and "
+                       f"method {method}; a time step of {stable_dt:.3g} s or less would be stable")
 
 
 def _round_to(n: int, multiple: int) -> int:

@@ -217,7 +217,7 @@ class Integrator:
     dt: float = spec("float", "time step", "s", low=0, open_low=True)
     t_end: float = spec("float", "end time", "s", low=0)
     method: str = spec("str", "integration method", default="symplectic_euler",
-                       choices=("symplectic_euler", "verlet", "yoshida4", "pefrl"))
+                       choices=("symplectic_euler", "verlet", "yoshida4", "pefrl", "rk4", "sdirk2"))
 
 
 @dataclass(frozen=True)

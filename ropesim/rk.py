@@ -1,0 +1,139 @@
+"""Explicit Runge-Kutta methods as Butcher tables, run by one compiled loop.
+
+For the rope, y = (x, v) and y' = F(t, y) = (v, a(x, v) - gamma v): the linear drag is an ordinary term of F
+(a Runge-Kutta method keeps its order with any smooth force, so nothing special is needed), and held nodes
+are placed at x0 + V (t + c_i h) at every stage, with stage velocity V and no acceleration. Stage s computes
+
+    Y_s = y + h sum_{j<s} a_sj K_j,   K_s = F(t + c_s h, Y_s),   y <- y + h sum_s b_s K_s.
+
+Unlike the splitting schemes these methods are not symplectic: their energy error drifts (RK4 dissipates).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from .health import BOX, DRAG, HELD, OK, end_step, held_power, place_held, power
+from .kernel import GUIDES, THROWER, accelerations, box_accelerations
+
+
+@dataclass(frozen=True)
+class RungeKutta:
+    """An explicit Runge-Kutta method: ``a`` (strictly lower triangular, as rows), weights ``b``, nodes ``c``."""
+
+    name: str
+    order: int
+    a: tuple[tuple[float, ...], ...]
+    b: tuple[float, ...]
+    c: tuple[float, ...]
+    doc: str
+    kind: str = "rk"
+
+    @property
+    def evaluations(self) -> int:
+        return len(self.b)
+
+    @property
+    def reuses_last_force(self) -> bool:
+        return False
+
+    @property
+    def stability_limit(self) -> float:
+        """Largest h omega for which the method stays bounded on x'' = -omega^2 x (where |R(i y)| <= 1)."""
+        from .integrators import stable_step
+
+        return stable_step(self, 1.0)
+
+    def amplification(self, h: float, omega: float, gamma_force: float = 0.0, gamma_drag: float = 0.0):
+        """One step's 2x2 map of (x, v) for x'' = -omega^2 x - (gamma_force + gamma_drag) x' (both explicit)."""
+        lin = np.array([[0.0, 1.0], [-omega * omega, -(gamma_force + gamma_drag)]]) * h
+        stages = []
+        for s in range(len(self.b)):
+            y = np.eye(2) + sum(self.a[s][j] * stages[j] for j in range(s)) if s else np.eye(2)
+            stages.append(lin @ y)
+        return np.eye(2) + sum(bs * k for bs, k in zip(self.b, stages))
+
+    def tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        s = len(self.b)
+        a = np.zeros((s, s))
+        for i, row in enumerate(self.a):
+            a[i, :len(row)] = row
+        return a, np.array(self.b, dtype=float), np.array(self.c, dtype=float)
+
+
+RK4 = RungeKutta(
+    "rk4", 4,
+    a=((), (0.5,), (0.0, 0.5), (0.0, 0.0, 1.0)),
+    b=(1 / 6, 1 / 3, 1 / 3, 1 / 6),
+    c=(0.0, 0.5, 0.5, 1.0),
+    doc="Classical fourth-order Runge-Kutta, a non-symplectic comparison: 4 force evaluations per step, drag "
+        "explicit (so strong drag limits its step too), energy slowly dissipated.")
+
+
+@njit(cache=True, error_model="numpy")
+def advance_rk(x, v, xs, vs, kx, kv, acc, acc_box, ledger, step0, n_steps, total_steps, h, a, b, c, gamma, held,
+               mass, forces, limits, save_every, frames, check_every):
+    """Advance ``n_steps`` Runge-Kutta steps in place; arguments and result as for
+    :func:`ropesim.integrators.advance`. ``xs``, ``vs`` (D, N) and ``kx``, ``kv`` (S, D, N) are scratch;
+    ``gamma`` (N,) is b / m (zero for held nodes)."""
+    dim, n = x.shape
+    stages = b.shape[0]
+    held_idx, held_x0, held_v = held
+    flags = forces[1]
+    has_box = flags[THROWER] != 0 or flags[GUIDES] != 0
+    frame = 0
+    for s in range(n_steps):
+        step = step0 + s
+        t = step * h
+        for st in range(stages):
+            for d in range(dim):
+                for i in range(n):
+                    px = x[d, i]
+                    pv = v[d, i]
+                    for j in range(st):
+                        w = a[st, j] * h
+                        if w != 0.0:
+                            px += w * kx[j, d, i]
+                            pv += w * kv[j, d, i]
+                    xs[d, i] = px
+                    vs[d, i] = pv
+            place_held(xs, held_idx, held_x0, held_v, t + c[st] * h)
+            for j in range(held_idx.shape[0]):
+                for d in range(dim):
+                    vs[d, held_idx[j]] = held_v[d, j]
+            accelerations(xs, vs, acc, forces)
+            lost = 0.0
+            for d in range(dim):
+                for i in range(n):
+                    kx[st, d, i] = vs[d, i]
+                    kv[st, d, i] = acc[d, i] - gamma[i] * vs[d, i]
+                    lost += gamma[i] * mass[i] * vs[d, i] * vs[d, i]
+            for j in range(held_idx.shape[0]):
+                for d in range(dim):
+                    kv[st, d, held_idx[j]] = 0.0
+            wh = b[st] * h
+            ledger[DRAG] += wh * lost
+            ledger[HELD] += wh * held_power(acc, mass, held_idx, held_v)
+            if has_box:
+                box_accelerations(xs, vs, acc_box, forces)
+                ledger[BOX] += wh * power(acc_box, vs, mass)
+        for d in range(dim):
+            for i in range(n):
+                dx = 0.0
+                dv = 0.0
+                for st in range(stages):
+                    dx += b[st] * kx[st, d, i]
+                    dv += b[st] * kv[st, d, i]
+                x[d, i] += h * dx
+                v[d, i] += h * dv
+        place_held(x, held_idx, held_x0, held_v, (step + 1) * h)
+        status, node, frame = end_step(step + 1, total_steps, save_every, check_every, h, x, v, mass, forces, ledger,
+                                       limits, frames, frame)
+        if status != OK:
+            return s + 1, frame, status, node
+    return n_steps, frame, OK, -1
+
+
