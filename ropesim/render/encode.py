@@ -66,7 +66,8 @@ def write_gif(frames: Iterable[np.ndarray], path: Path, fps: float, samples: lis
     images = (Image.fromarray(f).convert("RGB").quantize(palette=palette, dither=Image.Dither.NONE)
               for f in frames)
     first = next(images)
-    first.save(path, format="GIF", save_all=True, append_images=images, loop=0,
+    # optimize=False: Pillow's per-frame palette trimming halves the writing speed for files 15 % smaller
+    first.save(path, format="GIF", save_all=True, append_images=images, loop=0, optimize=False,
                duration=10 * round(100.0 / gif_fps(fps)))
 
 
