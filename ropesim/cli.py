@@ -59,12 +59,15 @@ def run(
     animate_: Annotated[bool, typer.Option("--animate", help="Then animate the run into RUN_FOLDER/animation.gif "
                                                              "(more choices: `ropesim animate`).")] = False,
     fps: FpsOpt = 25.0,
+    force: Annotated[bool, typer.Option("--force", help="Run even when dt is above the method's stability bound "
+                                                        "(see `ropesim check`).")] = False,
 ) -> None:
     """Run a scene and write trajectory.npz, scene.toml and summary.json into its run folder."""
     from .report import print_summary
     from .run import BLEW_UP, INTERRUPTED, simulate
 
     scene = _load(scene_file, sets)
+    _check_time_step(scene, scene_file, force, quiet)
     folder = out if out is not None else Path("runs") / scene.name
     if folder.exists() and not folder.is_dir():
         fail(f"--out {folder}: exists and is not a folder")
@@ -81,6 +84,23 @@ def run(
         fail(f"{scene_file}: {summary['message']}; frames up to then are in {folder}", EXIT_INTERRUPTED)
     if animate_:
         _animate(folder, None, quiet, fps=fps)
+
+
+def _check_time_step(scene, scene_file: Path, force: bool, quiet: bool) -> None:
+    """Refuse a dt above the stability bound (exit 2) unless --force; warn above 80 % of it."""
+    from .analysis.stability import WARN_FRACTION, time_step_verdict
+    from .build import build
+    from .run import TimeGrid
+
+    method, dt = scene.integrator.method, TimeGrid.of(scene).dt
+    verdict, bound = time_step_verdict(build(scene), method, dt)
+    where = f"{scene_file}: integrator.dt = {dt:.4g} s"
+    if verdict == "refuse" and not force:
+        fail(f"{where} is above {method}'s stability bound {bound:.4g} s; use a smaller dt, method = \"sdirk2\" "
+             f"(stable at any dt), or --force to run anyway")
+    if verdict != "ok" and not quiet:
+        typer.echo(f"ropesim: warning: {where} is {dt / bound:.0%} of {method}'s stability bound {bound:.4g} s "
+                   f"(warning above {WARN_FRACTION:.0%})", err=True)
 
 
 @app.command()
@@ -257,6 +277,107 @@ def plot(
     result = _picture(lambda: plot_run(Trajectory.open(run_dir), target))
     if not quiet:
         typer.echo(f"{result.path}: {', '.join(result.panels)}")
+
+
+MethodsOpt = Annotated[Optional[str], typer.Option(
+    "--methods", "-m", metavar="NAMES", help="Comma-separated integrators (default: all of "
+                                              "symplectic_euler, verlet, yoshida4, pefrl, rk4, sdirk2).",
+    show_default=False)]
+
+
+def _methods(text: str | None) -> list[str] | None:
+    from .integrators import METHODS
+
+    if not text:
+        return None
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    bad = [n for n in names if n not in METHODS]
+    if bad or not names:
+        fail(f"--methods {text}: unknown integrator {', '.join(bad) or '(none)'}; allowed {', '.join(METHODS)}")
+    return names
+
+
+def _numbers(text: str | None, option: str) -> list[float] | None:
+    if not text:
+        return None
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        values = []
+    if not values or not all(v > 0 and v < float("inf") for v in values):
+        fail(f"{option} {text}: must be a comma-separated list of positive numbers")
+    return values
+
+
+@app.command()
+def accuracy(
+    scene_file: SceneArg,
+    methods: MethodsOpt = None,
+    dts: Annotated[Optional[str], typer.Option(
+        "--dts", metavar="DT,DT,...", help="Time steps [s] (default: the scene's dt times 4, 2, 1, 1/2, 1/4, 1/8).",
+        show_default=False)] = None,
+    repeats: Annotated[int, typer.Option("--repeats", min=1, help="Timed runs per point (the median is kept).")] = 3,
+    sets: SetOpt = None,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", "-o", help="Folder for accuracy.csv and accuracy.png (default runs/accuracy-<scene name>/).",
+        show_default=False)] = None,
+) -> None:
+    """Error against run time: every integrator over a ladder of time steps, against a converged reference.
+
+    Prints the table and each method's observed order of convergence; writes accuracy.csv and a
+    work-precision plot (error against kernel wall time and against force evaluations).
+    """
+    from .analysis.accuracy import accuracy_report, plot, write_csv
+    from .report import print_accuracy
+
+    scene = _load(scene_file, sets)
+    names, ladder = _methods(methods), _numbers(dts, "--dts")
+    folder = out if out is not None else Path("runs") / f"accuracy-{scene.name}"
+    report = accuracy_report(scene, names, ladder, repeats)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        write_csv(report, folder / "accuracy.csv")
+        plot(report, folder / "accuracy.png")
+    except OSError as exc:
+        fail(f"{folder}: cannot write ({exc.strerror or exc})")
+    print_accuracy(report, folder)
+
+
+@app.command()
+def stability(
+    scene_file: SceneArg,
+    methods: MethodsOpt = None,
+    fractions: Annotated[Optional[str], typer.Option(
+        "--fractions", metavar="F,F,...", help="Time steps to probe, as fractions of 2 / omega_max (default 0.1, "
+                                              "0.2, ..., 2.0).", show_default=False)] = None,
+    stiffness: Annotated[Optional[str], typer.Option(
+        "--k", metavar="K,K,...", help="Also sweep the spring constant rope.stiffness [N/m].",
+        show_default=False)] = None,
+    steps: Annotated[int, typer.Option("--steps", min=10, help="Steps a probe run must survive.")] = 4000,
+    sets: SetOpt = None,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", "-o", help="Folder for stability.csv, bounds.csv and stability.png (default "
+                            "runs/stability-<scene name>/).", show_default=False)] = None,
+) -> None:
+    """Map where each method stays stable as dt (and k) vary, against the predicted bounds.
+
+    Each probe runs the scene from a slightly perturbed start; the blow-up dt of every explicit method is also
+    measured by bisection and printed beside its predicted bound.
+    """
+    from .analysis.stability import plot_sweep, stability_sweep, write_sweep
+    from .report import print_stability
+
+    scene = _load(scene_file, sets)
+    names, ladder = _methods(methods), _numbers(fractions, "--fractions")
+    ks = _numbers(stiffness, "--k")
+    folder = out if out is not None else Path("runs") / f"stability-{scene.name}"
+    result = stability_sweep(scene, names, ladder, ks, steps)
+    try:
+        write_sweep(result, folder)
+        plot_sweep(result, folder / "stability.png")
+    except OSError as exc:
+        fail(f"{folder}: cannot write ({exc.strerror or exc})")
+    print_stability(result, folder)
 
 
 def main() -> None:

@@ -4,7 +4,7 @@ Blow-up check (every ``check_every`` steps and at every saved frame), in this or
 
 - a non-finite position or velocity (NON_FINITE, naming the first such node);
 - a spring stretched beyond ``limits[0]`` times its rest length (OVERSTRETCH, naming its first node);
-- runaway energy (RUNAWAY_ENERGY, naming the fastest node): the energy balance
+- runaway energy (RUNAWAY_ENERGY, naming the fastest node): the energy balance residual
   E(t) - E(0) - (W_held + W_box - D_drag) exceeds ``limits[1]`` times the energy scale
   ``ledger[SCALE] + |W_held| + |W_box| + D_drag``. A stable run keeps that residual a small fraction of the
   scale (it is the integrator's energy error); an unstable one grows it geometrically, so the check fires

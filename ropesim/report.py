@@ -49,6 +49,13 @@ def print_summary(summary: dict, folder: Path) -> None:
         rows.append(("loop inclination", f"{shooter['loop_inclination_deg']:.1f} deg from vertical at t_end "
                                          f"(mean {shooter['mean_loop_inclination_deg']:.1f} deg over the last "
                                          f"{shooter['averaged_over_s']:.3g} s)"))
+    ledger = summary.get("energy_ledger")
+    if ledger:
+        rows.append(("energy ledger", f"drag took {ledger['drag_loss_J']:.4g} J, held nodes gave "
+                                      f"{ledger['held_work_J']:.4g} J, thrower and guides gave {ledger['box_work_J']:.4g} "
+                                      f"J; balance off by at most {ledger['max_residual_J']:.3g} J "
+                                      f"({ledger['relative_residual']:.2g} of the energy that "
+                                      f"{'flowed' if ledger['relative_to'] == 'flows' else 'moved'})"))
     if summary.get("message"):
         rows.append(("stopped", summary["message"]))
     rows.append(("written", f"{folder}/ (trajectory.npz, scene.toml, summary.json)"))
@@ -58,9 +65,8 @@ def print_summary(summary: dict, folder: Path) -> None:
 
 
 def print_check(scene: Scene, source: Path) -> None:
-    """What a scene contains, and its stability bound, without running it."""
-    from .build import build, stability_frequency
-    from .integrators import METHODS
+    """What a scene contains, and its stability bounds, without running it."""
+    from .build import build
     from .run import TimeGrid
 
     model = build(scene)
@@ -100,14 +106,84 @@ def print_check(scene: Scene, source: Path) -> None:
         table.add_row(f"node {o.index}", ", ".join(p for p in parts if p))
     table.add_row("time", f"{scene.integrator.method}, dt = {grid.dt:.6g} s, t_end = {scene.integrator.t_end:g} s "
                           f"({grid.steps} steps, {grid.frames} frames)")
-    omega = stability_frequency(model)
-    if omega > 0:
-        table.add_row("fastest mode", f"omega_max <= {omega:.4g} rad/s (Gershgorin bound on the mass-weighted "
-                                      f"stiffness)")
-        for name, scheme in METHODS.items():
-            bound = scheme.stability_limit / omega
-            mark = "  <- this scene" if name == scene.integrator.method else ""
-            verdict = "stable" if grid.dt <= bound else "UNSTABLE"
-            table.add_row(f"  {name}", f"dt <= {bound:.4g} s (h omega <= {scheme.stability_limit:.3f}); "
-                                       f"dt = {grid.dt:.3g} s is {verdict}{mark}")
+    for key, value in stability_rows(model, scene.integrator.method, grid.dt):
+        table.add_row(key, value)
     _console().print(table)
+
+
+def stability_rows(model, method: str, dt: float) -> list[tuple[str, str]]:
+    """The check table's stability rows: both bounds on omega_max and every method's largest stable dt."""
+    from .analysis.stability import WARN_FRACTION, bounds, drag_rates, explicit_damping
+
+    g, s, rows = bounds(model)
+    if g <= 0:
+        return [("fastest mode", "no free node: nothing to integrate")]
+    out = [("fastest mode", f"omega_max <= {s:.4g} rad/s (largest eigenvalue of the mass-weighted spring "
+                            f"stiffness); Gershgorin bound {g:.4g} rad/s")]
+    damping = explicit_damping(model)
+    if damping > 0:
+        out.append(("explicit damping", f"{damping:.4g} 1/s (thrower and guides' velocity terms, evaluated "
+                                        f"explicitly: they shorten the explicit methods' steps)"))
+    high = drag_rates(model)[1]
+    if high > 0:
+        out.append(("drag", f"b/m up to {high:.4g} 1/s: exact in the splitting schemes' kicks, explicit in rk4, "
+                            f"implicit in sdirk2"))
+    for b in rows:
+        mark = "  <- this scene" if b.method == method else ""
+        if b.dt_spectral == float("inf"):
+            out.append((f"  {b.method}", f"stable at any dt (L-stable implicit){mark}"))
+            continue
+        if dt > b.dt_spectral:
+            verdict = "UNSTABLE: `ropesim run` refuses it without --force"
+        elif dt > WARN_FRACTION * b.dt_spectral:
+            verdict = f"above {WARN_FRACTION:.0%} of the bound: `ropesim run` warns"
+        else:
+            verdict = "stable"
+        out.append((f"  {b.method}", f"dt <= {b.dt_spectral:.4g} s (Gershgorin: {b.dt_gershgorin:.4g} s; "
+                                     f"h omega <= {b.h_omega:.3f} undamped); dt = {dt:.3g} s is {verdict}{mark}"))
+    return out
+
+
+def print_accuracy(report, folder: Path) -> None:
+    """The accuracy table, the reference's convergence check and each method's observed order."""
+    from .analysis.accuracy import REFERENCE_FLOOR
+
+    ref = report.reference
+    table = Table(title=f"{report.scene.name}: error at t = {report.t_end:g} s against {ref.method} at dt = "
+                        f"{ref.dt:.3g} s", title_justify="left")
+    for col in ("method", "dt [s]", "largest error [m]", "RMS error [m]", "energy error [J]", "wall time [s]",
+                "force evals"):
+        table.add_column(col, justify="left" if col == "method" else "right")
+    for r in report.rows:
+        err = f"{r.error_max:.3e}" + (" *" if r.at_floor else "") if r.status == "completed" else r.status
+        table.add_row(r.method, f"{r.dt:.4g}", err, f"{r.error_rms:.3e}", f"{r.energy_error:.3e}",
+                      f"{r.wall_time:.3g}", f"{r.force_evaluations:,}")
+    console = _console()
+    console.print(table)
+    console.print(f"reference: two refinements differ by {ref.difference:.2e} m; errors below "
+                  f"{REFERENCE_FLOOR:g} x that (marked *) are left out of the orders")
+    for name, (order, used) in report.orders.items():
+        text = f"{order:.2f} (from {used} points)" if used >= 2 else "not measurable (fewer than 2 usable points)"
+        console.print(f"observed order of {name}: {text}")
+    console.print(f"written: {folder}/ (accuracy.csv, accuracy.png)")
+
+
+def print_stability(result, folder: Path) -> None:
+    """Predicted bounds against measured blow-up time steps."""
+    table = Table(title="stability: predicted bound against measured blow-up", title_justify="left")
+    for col in ("k [N/m]", "method", "bound [s]", "Gershgorin [s]", "measured blow-up [s]", "bound / measured"):
+        table.add_column(col, justify="left" if col == "method" else "right")
+    for b in result.bounds:
+        if b["predicted_dt_spectral"] == float("inf"):
+            table.add_row(f"{b['stiffness']:g}", b["method"], "none", "none",
+                          "none" if b["measured_blowup_dt"] == float("inf") else f"{b['measured_blowup_dt']:.4g}", "")
+            continue
+        ratio = b["predicted_dt_spectral"] / b["measured_blowup_dt"]
+        table.add_row(f"{b['stiffness']:g}", b["method"], f"{b['predicted_dt_spectral']:.4g}",
+                      f"{b['predicted_dt_gershgorin']:.4g}", f"{b['measured_blowup_dt']:.4g}", f"{ratio:.3f}")
+    unstable = [r for r in result.rows if r["method"] == "sdirk2" and not r["stable"]]
+    console = _console()
+    console.print(table)
+    if unstable:
+        console.print(f"sdirk2 failed {len(unstable)} probes (Newton did not converge or the energy balance broke)")
+    console.print(f"written: {folder}/ (stability.csv, bounds.csv, stability.png)")

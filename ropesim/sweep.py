@@ -2,7 +2,8 @@
 
 ``ropesim sweep SCENE --set drag.b=0.05:1.5:10 --set rope.nodes=21,41`` runs every combination. A key's
 values are a list (``0.1,0.4,1.0``), an inclusive range ``start:stop:count`` (evenly spaced as numpy.linspace;
-whole numbers for integer keys) or a single value, which then applies to every run.
+whole numbers for integer keys, inner values to 12 significant digits) or a single value, which then
+applies to every run.
 
 Every combination is resolved to a complete scene before anything runs, so a bad key or value stops the sweep
 with one line. Each run is the same :func:`ropesim.run.simulate` that ``ropesim run`` calls, in a process of
@@ -133,7 +134,8 @@ def _range(key: str, text: str) -> list | None:
             raise SweepError(f"--set {key}={text}: {key} is an integer and this range repeats whole numbers "
                              f"({', '.join(map(str, ints))}); use fewer values or a wider range")
         return ints
-    return [float(v) for v in values]
+    # Inner values to 12 significant digits, so 0:1.5:16 steps by 0.1 and not to 0.30000000000000004.
+    return [float(start)] + [float(f"{v:.12g}") for v in values[1:-1]] + ([float(stop)] if count > 1 else [])
 
 
 def _list(text: str) -> list:

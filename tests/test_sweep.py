@@ -40,9 +40,15 @@ def warm_kernel_cache():
 @given(start=st.floats(-1e3, 1e3), stop=st.floats(-1e3, 1e3), count=st.integers(1, 40))
 def test_range_is_inclusive_linspace(start, stop, count):
     axis = parse_axis(f"drag.b={start!r}:{stop!r}:{count}")
-    assert axis.values == tuple(float(v) for v in np.linspace(start, stop, count))
-    assert axis.values[0] == start and (count == 1 or axis.values[-1] == stop)
+    assert len(axis.values) == count
+    assert axis.values[0] == start and (count == 1 or axis.values[-1] == stop)  # the ends exactly as given
+    scale = max(abs(start), abs(stop), 1e-300)
+    assert np.allclose(axis.values, np.linspace(start, stop, count), rtol=1e-11, atol=1e-11 * scale)
     assert all(type(v) is float for v in axis.values)
+
+
+def test_range_steps_are_round_numbers():
+    assert parse_axis("drag.b=0:1.5:16").values == tuple(round(0.1 * i, 10) for i in range(16))
 
 
 def test_range_of_an_integer_key_gives_integers():

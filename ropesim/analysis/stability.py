@@ -164,3 +164,183 @@ def time_step_verdict(model: Model, method: str, dt: float) -> tuple[str, float]
     if dt > WARN_FRACTION * bound:
         return "warn", bound
     return "ok", bound
+
+
+# ------------------------------------------------------------------------------- measuring blow-ups
+
+PERTURBATION = 1e-6       # seed displacement of every free node, in segment lengths, so every mode is excited
+PROBE_STEPS = 4000        # steps a probe run must survive to count as stable
+BISECTIONS = 8
+
+
+def reference_dt(model: Model) -> float:
+    """The sweep's unit of time step [s]: 2 / omega_max (spectral), the leapfrog's undamped limit."""
+    omega = spectral_frequency(model)
+    return 2.0 / omega if omega > 0 else math.inf
+
+
+def probe(scene, method: str, dt: float, steps: int = PROBE_STEPS) -> bool:
+    """True when ``steps`` steps of ``dt`` from a slightly perturbed start stay sane.
+
+    Sane: no blow-up stop (non-finite, overstretched, runaway energy) and, stricter than a run's own check, an
+    energy balance residual at the end below the initial energy scale alone (a run's check also allows the
+    energy that flowed). That catches instabilities that saturate into bounded nonsense instead of
+    overflowing; stable runs of the built-in scenes stay below 0.15 of that scale even at 0.95 of the bound.
+    """
+    import dataclasses
+
+    from ..build import build
+    from ..health import BOX, DRAG, E0, HELD, OK, SCALE
+    from ..run import Stepper, TimeGrid
+    from .energy import energy_terms
+
+    integ = dataclasses.replace(scene.integrator, method=method, dt=dt, t_end=steps * dt)
+    out = dataclasses.replace(scene.output, interval=steps * dt)
+    scene = dataclasses.replace(scene, integrator=integ, output=out)
+    model = build(scene)
+    rng = np.random.default_rng(12345)
+    free = ~model.held
+    model.x0[:, free] += PERTURBATION * scene.rope.segment_length * rng.standard_normal((model.dim, free.sum()))
+    grid = TimeGrid.of(scene)
+    stepper = Stepper(model, method, grid)
+    _, _, status, _ = stepper.advance(grid.steps)
+    if status != OK:
+        return False
+    ledger = stepper.ledger
+    energy = float(energy_terms(model, stepper.x.T, stepper.v.T)["total"])
+    residual = energy - ledger[E0] - (ledger[HELD] + ledger[BOX] - ledger[DRAG])
+    return abs(residual) <= ledger[SCALE]
+
+
+def measured_dt(scene, method: str, guess: float, steps: int = PROBE_STEPS) -> tuple[float, float]:
+    """(largest stable dt found, smallest unstable dt found) [s], bracketing where ``method`` blows up.
+
+    Starts from ``guess`` (the predicted bound), widens by factors of 2 until it brackets the threshold, then
+    bisects BISECTIONS times (resolution about 0.4 %). (inf, inf) when no blow-up is found up to 1000 x guess.
+    """
+    lo, hi = None, None
+    dt = guess
+    for _ in range(12):
+        if probe(scene, method, dt, steps):
+            lo = dt
+            if hi is not None:
+                break
+            dt *= 2.0
+        else:
+            hi = dt
+            if lo is not None:
+                break
+            dt /= 2.0
+        if dt > 1000 * guess:
+            return math.inf, math.inf
+    if lo is None or hi is None:
+        return (lo or 0.0), (hi or math.inf)
+    for _ in range(BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if probe(scene, method, mid, steps) else (lo, mid)
+    return lo, hi
+
+
+@dataclass
+class SweepResult:
+    rows: list            # dicts: stiffness, method, dt, dt_over_ref, stable
+    bounds: list          # dicts: stiffness, method, predicted (spectral, Gershgorin), measured (lo, hi)
+
+
+def stability_sweep(scene, methods=None, fractions=None, stiffnesses=None, steps: int = PROBE_STEPS,
+                    progress=None) -> SweepResult:
+    """Map stable and unstable time steps per method (and per stiffness k), against the predicted bounds.
+
+    dt runs over ``fractions`` of the reference step 2 / omega_max (default 0.1 to 2.0); for every explicit
+    method the blow-up dt is also measured by bisection. The stiff integrator is probed on the same ladder
+    (it should be stable everywhere).
+    """
+    import dataclasses
+
+    from ..build import build
+
+    methods = list(methods or METHODS)
+    fractions = fractions or [round(0.1 * i, 2) for i in range(1, 21)]
+    stiffnesses = stiffnesses or [scene.rope.stiffness]
+    rows, bound_rows = [], []
+    for k in stiffnesses:
+        sc = dataclasses.replace(scene, rope=dataclasses.replace(scene.rope, stiffness=k))
+        model = build(sc)
+        unit = reference_dt(model)
+        g, s = gershgorin_frequency(model), spectral_frequency(model)
+        for name in methods:
+            if progress is not None:
+                progress(k, name)
+            pred_s, pred_g = predicted_dt(model, name, s), predicted_dt(model, name, g)
+            for f in fractions:
+                rows.append({"stiffness": k, "method": name, "dt": f * unit, "dt_over_ref": f,
+                             "stable": probe(sc, name, f * unit, steps)})
+            lo, hi = (math.inf, math.inf) if not math.isfinite(pred_s) else measured_dt(sc, name, pred_s, steps)
+            bound_rows.append({"stiffness": k, "method": name, "ref_dt": unit, "omega_gershgorin": g,
+                               "omega_spectral": s, "predicted_dt_spectral": pred_s, "predicted_dt_gershgorin": pred_g,
+                               "measured_stable_dt": lo, "measured_blowup_dt": hi})
+    return SweepResult(rows, bound_rows)
+
+
+def write_sweep(result: SweepResult, folder) -> tuple:
+    """Write stability.csv (every probe) and bounds.csv (predicted against measured) into ``folder``."""
+    import csv
+    import io
+    from pathlib import Path
+
+    from ..trajectory import write_text_atomic
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for name, rows in (("stability.csv", result.rows), ("bounds.csv", result.bounds)):
+        buf = io.StringIO()
+        w = csv.DictWriter(buf, fieldnames=list(rows[0]))
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
+        write_text_atomic(folder / name, buf.getvalue())
+        paths.append(folder / name)
+    return tuple(paths)
+
+
+def plot_sweep(result: SweepResult, path) -> None:
+    """One row per method: probes at each dt (and k), the predicted bound (line) and the measured blow-up."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ..render.output import atomic_output
+
+    methods = list(dict.fromkeys(r["method"] for r in result.rows))
+    ks = sorted({r["stiffness"] for r in result.rows})
+    fig, ax = plt.subplots(figsize=(9, 1.0 + 0.55 * len(methods) * len(ks)), constrained_layout=True)
+    labels = []
+    y = 0
+    for name in methods:
+        for k in ks:
+            pts = [r for r in result.rows if r["method"] == name and r["stiffness"] == k]
+            ok = [r["dt_over_ref"] for r in pts if r["stable"]]
+            bad = [r["dt_over_ref"] for r in pts if not r["stable"]]
+            ax.plot(ok, [y] * len(ok), "o", color="tab:green", ms=5, label="stable" if y == 0 else None)
+            ax.plot(bad, [y] * len(bad), "x", color="tab:red", ms=6, label="blew up" if y == 0 else None)
+            b = next(r for r in result.bounds if r["method"] == name and r["stiffness"] == k)
+            if math.isfinite(b["predicted_dt_spectral"]):
+                ax.plot([b["predicted_dt_spectral"] / b["ref_dt"]] * 2, [y - 0.35, y + 0.35], "-", color="k", lw=2,
+                        label="predicted bound" if y == 0 else None)
+                ax.plot([b["predicted_dt_gershgorin"] / b["ref_dt"]] * 2, [y - 0.35, y + 0.35], ":", color="k",
+                        lw=1.5, label="Gershgorin bound" if y == 0 else None)
+            if math.isfinite(b["measured_blowup_dt"]):
+                ax.plot([b["measured_blowup_dt"] / b["ref_dt"]], [y], "|", color="tab:blue", ms=16, mew=2,
+                        label="measured blow-up" if y == 0 else None)
+            labels.append(f"{name}" + (f", k = {k:g}" if len(ks) > 1 else ""))
+            y += 1
+    ax.set_yticks(range(len(labels)), labels)
+    ax.invert_yaxis()
+    ax.set_xlabel("dt / (2 / omega_max)")
+    ax.grid(True, axis="x", alpha=0.3)
+    ax.legend(fontsize=8, loc="upper right", ncol=2)
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)

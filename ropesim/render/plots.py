@@ -65,6 +65,35 @@ def draw_energy(ax, traj: Trajectory, model: Model) -> None:
     ax.legend(fontsize=7, ncol=len(terms), loc="best")
 
 
+def draw_ledger(ax, traj: Trajectory, model: Model) -> None:
+    """The energy ledger: E(t) - E(0), the flows in and out, and the balance's residual (see analysis.ledger)."""
+    from ..analysis.ledger import ledger_series, ledger_summary, read_flows
+
+    stored = read_flows(traj.folder) if traj.folder is not None else None
+    if stored is None:
+        ax.text(0.5, 0.5, "no ledger.npz in this run folder (made by an older ropesim)", ha="center",
+                transform=ax.transAxes)
+        ax.set_title("Energy ledger")
+        return
+    flows, energy0 = stored
+    n = min(len(flows), traj.frames)
+    series = ledger_series(model, traj.x, traj.v, flows[:n], energy0)
+    t = traj.t[:n]
+    ax.plot(t, series["total"] - energy0, color="black", linewidth=1.6, label="E(t) - E(0)")
+    ax.plot(t, series["held_work"], linewidth=1.1, label="work by held nodes")
+    if np.any(series["box_work"]):
+        ax.plot(t, series["box_work"], linewidth=1.1, label="work by thrower and guides")
+    ax.plot(t, -series["drag_loss"], linewidth=1.1, label="- loss to drag")
+    ax.plot(t, series["residual"], color="#d62728", linewidth=1.4, label="residual (integration error)")
+    ax.axhline(0, color="0.6", linewidth=0.8)
+    summary = ledger_summary(series, energy0)
+    ax.set_ylabel("energy [J]")
+    ax.set_title(f"Energy ledger: largest residual {summary['max_residual_J']:.3g} J = "
+                 f"{summary['relative_residual']:.2g} of the energy that "
+                 f"{'flowed' if summary['relative_to'] == 'flows' else 'moved'}")
+    ax.legend(fontsize=7, ncol=3, loc="best")
+
+
 def draw_stretch(ax, traj: Trajectory, model: Model) -> None:
     stretch = 100 * largest_stretch_series(traj, model)
     ax.plot(traj.t, stretch, color="#9467bd")
@@ -121,8 +150,7 @@ class Panel:
 
 PANELS = (
     Panel("energy", lambda model: True, draw_energy),
-    # The energy ledger (issue 4: work done by drag, the driven nodes and the thrower box, which with the
-    # mechanical energy above adds up to a constant) belongs here, as its own Panel.
+    Panel("ledger", lambda model: True, draw_ledger),
     Panel("stretch", lambda model: True, draw_stretch),
     Panel("towed", lambda model: towed_end(model.scene) is not None, draw_towed, time_axis=False),
     Panel("shooter", lambda model: model.scene.thrower is not None and model.scene.rope.closed, draw_inclination),
