@@ -101,7 +101,7 @@ def build(scene: S.Scene) -> Model:
     guides = np.zeros((0, GUIDE_PARAMS))
     if scene.guides:
         flags[GUIDES] = 1
-        guides = np.array([[c.center[0], c.center[1], c.radius, c.omega0 ** 2, 2 * c.damping_ratio * c.omega0,
+        guides = np.array([[c.center[0], c.center[1], c.radius, c.omega0 * c.omega0, 2 * c.damping_ratio * c.omega0,
                             1.0 if c.one_sided else 0.0] for c in scene.guides])
 
     forces = (1.0 / mass, flags, spring, bending, gravity, thrower, guides)
@@ -177,9 +177,9 @@ def stability_frequency(model: Model) -> float:
         np.add.at(row, j, k / model.mass[j] + coupling)
     extra = 0.0
     if scene.thrower is not None:
-        extra = scene.thrower.omega0 ** 2
+        extra = scene.thrower.omega0 * scene.thrower.omega0  # inf, not OverflowError, if absurdly large
     for guide in scene.guides:
-        extra = max(extra, guide.omega0 ** 2)
+        extra = max(extra, guide.omega0 * guide.omega0)
     row[~model.held] += extra
     free = ~model.held
     return float(math.sqrt(row[free].max())) if free.any() else 0.0

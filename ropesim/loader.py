@@ -16,6 +16,9 @@ from typing import Any
 from . import scene as S
 
 
+MAX_STEPS = 1e12  # a run of more steps would take days; t_end / dt beyond it is a typo, not a plan
+
+
 class SceneError(ValueError):
     """A scene that cannot be used; ``str()`` is the one line to show the user."""
 
@@ -78,7 +81,7 @@ def apply_override(raw: dict, item: str, source: str = "--set") -> None:
             node = _list_item(node, part, here, source, item)
         elif isinstance(node, dict):
             if part not in node:
-                node[part] = [{}] if part in S.ARRAYS_OF_TABLES and parts[depth + 1].isdigit() else {}
+                node[part] = [{}] if part in S.ARRAYS_OF_TABLES and _is_index(parts[depth + 1]) else {}
             node = node[part]
         else:
             raise SceneError(source, here, f"is a value, not a table, so --set {item} cannot go inside it")
@@ -93,8 +96,13 @@ def apply_override(raw: dict, item: str, source: str = "--set") -> None:
                                                        f"inside it")
 
 
+def _is_index(part: str) -> bool:
+    """True for a list index in a dotted key: ASCII digits only (``str.isdigit`` also admits e.g. '²')."""
+    return part.isascii() and part.isdigit()
+
+
 def _list_item(items: list, part: str, here: str, source: str, item: str):
-    if not part.isdigit():
+    if not _is_index(part):
         raise SceneError(source, here, f"is a list; address its entries by number (e.g. {here}.0...) in "
                                        f"--set {item}")
     index = int(part)
@@ -161,11 +169,12 @@ class _Ctx:
             raise SceneError(self.source, path, f"must be a table, got {_show(raw)}")
         return self.build(raw, cls, path)
 
-    def build(self, raw: dict, cls, path: str, skip: tuple = ()):
+    def build(self, raw: dict, cls, path: str, skip: tuple = (), what: str = ""):
         specs = {f.name: f.metadata["spec"] for f in fields(cls) if "spec" in f.metadata}
         for key in raw:
             if key not in specs and key not in skip:
-                raise SceneError(self.source, f"{path}.{key}", _unknown(key, list(specs), f"a key of [{path}]"))
+                raise SceneError(self.source, f"{path}.{key}",
+                                 _unknown(key, list(skip) + list(specs), what or f"a key of [{path}]"))
         values = {}
         for name, sp in specs.items():
             if name in raw:
@@ -182,7 +191,8 @@ class _Ctx:
         if "shape" not in init:
             raise SceneError(self.source, "initial.shape", f"missing: one of {_choices(shape_spec.choices)}")
         shape = _value(init["shape"], shape_spec, "initial.shape", self.source, self.dim)
-        start = self.build(init, S.INITIAL_SHAPES[shape], "initial", skip=("shape",))
+        start = self.build(init, S.INITIAL_SHAPES[shape], "initial", skip=("shape",),
+                           what=f"a key of [initial] with shape = '{shape}'")
         zeros = (0.0,) * self.dim
         if start.velocity is None:
             start = replace(start, velocity=zeros)
@@ -197,6 +207,15 @@ def _check_scene(scene: S.Scene, source: str) -> S.Scene:
 
     def fail(key, message):
         raise SceneError(source, key, message)
+
+    name = scene.name
+    if not name or name in (".", "..") or "/" in name or "\\" in name or not name.isprintable():
+        fail("name", f"must be a plain folder name (runs go to runs/<name>/): printable, without / or \\, "
+                     f"not '.' or '..'; got {_show(name)}")
+    steps = scene.integrator.t_end / scene.integrator.dt
+    if steps > MAX_STEPS:
+        fail("integrator.t_end", f"t_end / dt = {steps:.3g} steps; at most {MAX_STEPS:.0e} are allowed "
+                                 f"(t_end = {scene.integrator.t_end:g} s, dt = {scene.integrator.dt:g} s)")
 
     if rope.closed and n < 3:
         fail("rope.nodes", f"a closed loop needs at least 3 nodes, got {n}")
@@ -264,7 +283,11 @@ def _check_scene(scene: S.Scene, source: str) -> S.Scene:
                 fail("initial.points", f"nodes {i} and {j} coincide; a spring between them has no direction")
 
     if scene.thrower is not None and scene.thrower.omega0 is None:
-        scene = replace(scene, thrower=replace(scene.thrower, omega0=scene.thrower.resolved_omega0))
+        w = scene.thrower.resolved_omega0
+        if not 0 < w < math.inf:
+            fail("thrower.omega0", f"missing: its default 4 pi |v_max| / length is {w:g} rad/s here; give a "
+                                   f"finite omega0 > 0")
+        scene = replace(scene, thrower=replace(scene.thrower, omega0=w))
     guides = []
     for j, guide in enumerate(scene.guides):
         if guide.omega0 is None:
@@ -309,9 +332,9 @@ def _value(value: Any, sp: S.Spec, key: str, source: str, dim: int):
     if sp.kind == "float":
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             bad(f"must be {_range(sp, 'a number')}")
-        value = float(value)
-        if not math.isfinite(value):
+        if not _finite(value):
             bad("must be a finite number")
+        value = float(value)
         _bounds(value, sp, key, source, "a number")
         return value
     if sp.kind == "vector":
@@ -332,11 +355,18 @@ def _value(value: Any, sp: S.Spec, key: str, source: str, dim: int):
 
 def _vector(value, dim, key, source, sp):
     ok = isinstance(value, list) and len(value) == dim and all(
-        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value)
+        isinstance(v, (int, float)) and not isinstance(v, bool) and _finite(v) for v in value)
     if not ok:
         raise SceneError(source, key, f"must be a list of {dim} finite numbers (dimension = {dim}){_unit(sp)}, "
                                       f"got {_show(value)}")
     return tuple(float(v) for v in value)
+
+
+def _finite(v) -> bool:
+    try:
+        return math.isfinite(v)
+    except OverflowError:  # an integer beyond the float range
+        return False
 
 
 def _bounds(value, sp: S.Spec, key, source, what):

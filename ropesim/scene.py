@@ -51,7 +51,7 @@ def spec(kind: str, doc: str, unit: str = "", default: Any = None, required: boo
 class Rope:
     """N point masses joined by springs of stiffness k and rest length l; an open line or a closed loop."""
 
-    nodes: int = spec("int", "number of point masses N", low=2)
+    nodes: int = spec("int", "number of point masses N", low=2, high=1_000_000)
     segment_length: float = spec("float", "rest length l of each spring", "m", low=0, open_low=True)
     stiffness: float = spec("float", "spring constant k between neighbours", "N/m", low=0, open_low=True)
     mass: float = spec("float", "mass m of each node", "kg", low=0, open_low=True)

@@ -1,0 +1,695 @@
+"""The strict scene loader: what it accepts, how it refuses, --set overrides, the resolved-scene round trip,
+property-based attacks on it, and the README's schema reference kept in step with the schema."""
+
+from __future__ import annotations
+
+import copy
+import math
+import re
+import tomllib
+from dataclasses import MISSING, fields
+from pathlib import Path
+
+import pytest
+import tomli_w
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from ropesim import scene as S
+from ropesim.build import build
+from ropesim.loader import SceneError, apply_override, load_scene, parse_override, scene_from_toml
+from ropesim.run import TimeGrid
+
+from conftest import ROOT, SCENARIOS
+
+SOURCE = "t.toml"
+SCENARIO_FILES = sorted(SCENARIOS.glob("*.toml"))
+
+# A small valid open rope, and a small valid loop with a thrower; the refusal tests change one thing at a time.
+LINE = {
+    "rope": {"nodes": 5, "segment_length": 1.0, "stiffness": 100.0, "mass": 1.0},
+    "initial": {"shape": "hanging"},
+    "integrator": {"dt": 0.001, "t_end": 0.1},
+}
+LOOP = {
+    "rope": {"nodes": 8, "segment_length": 1.0, "stiffness": 100.0, "mass": 1.0, "closed": True},
+    "initial": {"shape": "square_loop"},
+    "thrower": {"center": [0.0, 0.0], "length": 2.0, "width": 1.0, "v_max": 1.0, "b_thrower": 5.0},
+    "guides": [{"center": [-1.0, 0.0], "radius": 0.5}, {"center": [1.0, 0.0], "radius": 0.5}],
+    "integrator": {"dt": 0.001, "t_end": 0.1},
+}
+DELETE = object()
+
+
+def variant(base: dict, **changes) -> dict:
+    """``base`` with dotted keys (``__`` for ``.``) set, or removed when the value is DELETE."""
+    raw = copy.deepcopy(base)
+    for dotted, value in changes.items():
+        *path, last = dotted.split("__")
+        node = raw
+        for part in path:
+            node = node[int(part)] if isinstance(node, list) else node.setdefault(part, {})
+        if value is DELETE:
+            del node[last]
+        else:
+            node[last] = value
+    return raw
+
+
+def load(raw: dict | str, source: str = SOURCE, sets=()) -> S.Scene:
+    text = raw if isinstance(raw, str) else tomli_w.dumps(raw)
+    return scene_from_toml(text, source=source, default_name="t", overrides=sets)
+
+
+def assert_one_line(exc: SceneError, source: str = SOURCE) -> str:
+    text = str(exc)
+    assert "\n" not in text and "\r" not in text, text
+    assert text.startswith(f"{source}: ") or text.startswith(f"{source} (with --set"), text
+    return text
+
+
+def refused(raw, key: str, *fragments: str, source: str = SOURCE, sets=()) -> str:
+    """Assert that loading fails with one line naming the source, ``key`` and every fragment; return it."""
+    with pytest.raises(SceneError) as info:
+        load(raw, source, sets)
+    text = assert_one_line(info.value, source)
+    assert info.value.key == key, text
+    assert f": {key}: " in text, text
+    for fragment in fragments:
+        assert fragment in text, f"{fragment!r} not in {text!r}"
+    return text
+
+
+# ------------------------------------------------------------------------------------ accepted scenes
+
+
+def test_minimal_scenes_get_every_default():
+    line = load(LINE)
+    assert line.name == "t" and line.dimension == 2 and line.description == ""
+    assert line.rope.closed is False
+    assert line.initial == S.HangingStart(top=(0.0, 0.0), velocity=(0.0, 0.0))
+    assert line.integrator.method == "symplectic_euler"
+    assert line.output.interval == 0.01
+    assert line.gravity is None and line.drag is None and line.bending is None and line.thrower is None
+    assert line.guides == () and line.driven == () and line.overrides == () and line.pinned is None
+
+    loop = load(LOOP)
+    assert loop.initial.top_center == (0.0, 0.0)  # the thrower's centre
+    assert loop.thrower.omega0 == pytest.approx(4 * math.pi * 1.0 / 2.0)  # 2 (2 pi v_max / L)
+    assert [g.omega0 for g in loop.guides] == [loop.thrower.omega0] * 2
+    assert [g.one_sided for g in loop.guides] == [False, False]
+    assert load(variant(LINE, gravity={})).gravity.g == 9.81
+
+
+def test_integers_are_numbers_and_single_values_are_lists():
+    scene = load(variant(LINE, rope__mass=2, pinned={"nodes": -1}, guides={"center": [0, 3], "radius": 1,
+                                                                             "omega0": 2}))
+    assert scene.rope.mass == 2.0 and isinstance(scene.rope.mass, float)
+    assert scene.pinned.nodes == (-1,) and scene.node(-1) == 4
+    assert len(scene.guides) == 1 and scene.guides[0].center == (0.0, 3.0)
+
+
+def test_every_part_together_in_3d():
+    raw = {
+        "name": "all", "description": "every part", "dimension": 3,
+        "rope": {"nodes": 6, "segment_length": 0.5, "stiffness": 1e3, "mass": 0.2},
+        "bending": {"stiffness": 10.0},
+        "initial": {"shape": "line", "start": [0, 0, 0], "end": [2.5, 0, 0], "velocity": [0, 0, 1]},
+        "gravity": {"g": 9.8}, "drag": {"b": 0.1},
+        "pinned": {"nodes": [0]},
+        "driven": [{"nodes": [-1], "velocity": [1, 0, 0]}],
+        "overrides": [{"index": -2, "mass": 3.0}, {"index": 2, "drag": 0.0}],
+        "integrator": {"method": "yoshida4", "dt": 1e-4, "t_end": 0.5},
+        "output": {"interval": 0.05},
+    }
+    scene = load(raw)
+    assert scene.dimension == 3 and scene.initial.end == (2.5, 0.0, 0.0)
+    model = build(scene)
+    assert model.x0.shape == (3, 6) and model.mass[4] == 3.0 and model.drag[2] == 0.0 and model.drag[3] == 0.1
+    assert list(model.held_idx) == [0, 5]
+
+
+def test_points_and_explicit_top_center():
+    pts = [[0, 0], [1, 0], [1, -1], [0, -1]]
+    scene = load(variant(LINE, rope__nodes=4, rope__closed=True, initial={"shape": "points", "points": pts}))
+    assert scene.initial.points == tuple(tuple(float(c) for c in p) for p in pts)
+    loop = load(variant(LOOP, initial__top_center=[3, 4]))
+    assert loop.initial.top_center == (3.0, 4.0)
+
+
+# ---------------------------------------------------------------------------------------- refusals
+
+UNKNOWN_KEYS = [
+    ("ropes", "rope"), ("integrater", "integrator"), ("gravty", "gravity"), ("overide", "overrides"),
+    ("rope__mas", "mass"), ("rope__closd", "closed"), ("integrator__tend", "t_end"),
+    ("integrator__methd", "method"), ("output__intervall", "interval"), ("initial__tpo", "top"),
+]
+
+
+@pytest.mark.parametrize("dotted,near", UNKNOWN_KEYS)
+def test_misspelt_key_suggests_the_nearest(dotted, near):
+    refused(variant(LINE, **{dotted: 1}), dotted.replace("__", "."), f"did you mean '{near}'?", "allowed:")
+
+
+@pytest.mark.parametrize("dotted,near", [
+    ("thrower__vmax", "v_max"), ("thrower__omega", "omega0"), ("guides__1__raduis", "radius"),
+    ("guides__0__onesided", "one_sided"), ("bending__stifness", "stiffness"),
+])
+def test_misspelt_key_in_the_shooter_parts(dotted, near):
+    raw = variant(LOOP, bending={"stiffness": 1.0}, **{dotted: 1})
+    refused(raw, dotted.replace("__", "."), f"did you mean '{near}'?")
+
+
+@pytest.mark.parametrize("dotted,near,extra", [
+    ("driven__0__velocty", "velocity", {"driven": [{"nodes": [0], "velocity": [1, 0]}]}),
+    ("overrides__0__mas", "mass", {"overrides": [{"index": -1, "mass": 2.0}]}),
+    ("pinned__node", "nodes", {"pinned": {"nodes": [0]}}),
+    ("drag__bb", "b", {"drag": {"b": 1.0}}),
+    ("gravity__gg", "g", {"gravity": {"g": 1.0}}),
+])
+def test_misspelt_key_in_the_held_and_force_parts(dotted, near, extra):
+    refused(variant(variant(LINE, **extra), **{dotted: 1}), dotted.replace("__", "."), f"did you mean '{near}'?")
+
+
+def test_unknown_key_without_a_near_one_lists_what_is_allowed():
+    text = refused(variant(LINE, zzzz=1), "zzzz", "allowed: name, description, dimension, rope, initial")
+    assert "did you mean" not in text
+    refused(variant(LINE, rope__qqqq=1), "rope.qqqq", "allowed: nodes, segment_length, stiffness, mass, closed")
+
+
+@pytest.mark.parametrize("shape,extra,key,allowed", [
+    ("hanging", {"start": [0, 0]}, "initial.start", "allowed: shape, top, velocity"),
+    ("line", {"start": [0, 0], "end": [0, -4], "top": [0, 0]}, "initial.top", "allowed: shape, start, end, velocity"),
+    ("points", {"points": [[0, 0], [0, -1], [0, -2], [0, -3], [0, -4]], "top_center": [0, 0]},
+     "initial.top_center", "allowed: shape, points, velocity"),
+])
+def test_keys_of_another_initial_shape_are_refused(shape, extra, key, allowed):
+    refused(variant(LINE, initial={"shape": shape, **extra}), key, f"with shape = '{shape}'", allowed)
+
+
+def test_square_loop_refuses_points():
+    refused(variant(LOOP, initial__points=[[0, 0]]), "initial.points", "with shape = 'square_loop'",
+            "allowed: shape, top_center, velocity")
+
+
+WRONG_TYPES = [
+    ({"rope__nodes": 5.0}, "rope.nodes", "must be an integer >= 2"),
+    ({"rope__nodes": "5"}, "rope.nodes", "got '5'"),
+    ({"rope__nodes": True}, "rope.nodes", "must be an integer"),
+    ({"rope__mass": "heavy"}, "rope.mass", "must be a number > 0 [kg], got 'heavy'"),
+    ({"rope__mass": True}, "rope.mass", "must be a number"),
+    ({"rope__mass": [1.0]}, "rope.mass", "must be a number"),
+    ({"rope__closed": 1}, "rope.closed", "must be true or false"),
+    ({"rope__closed": "yes"}, "rope.closed", "must be true or false"),
+    ({"initial__top": [0]}, "initial.top", "must be a list of 2 finite numbers (dimension = 2) [m]"),
+    ({"initial__top": [0, 0, 0]}, "initial.top", "list of 2 finite numbers"),
+    ({"initial__top": [0, "1"]}, "initial.top", "list of 2 finite numbers"),
+    ({"initial__velocity": "fast"}, "initial.velocity", "list of 2 finite numbers"),
+    ({"initial__shape": 3}, "initial.shape", "must be one of 'hanging', 'line', 'square_loop', 'points'"),
+    ({"initial__shape": "hangin"}, "initial.shape", "did you mean 'hanging'?"),
+    ({"integrator__method": "verlett"}, "integrator.method", "did you mean 'verlet'?"),
+    ({"integrator__method": 3}, "integrator.method", "must be one of 'symplectic_euler', 'verlet'"),
+    ({"integrator__dt": "0.001"}, "integrator.dt", "must be a number > 0 [s]"),
+    ({"dimension": 4}, "dimension", "must be one of 2, 3"),
+    ({"dimension": "3"}, "dimension", "must be one of 2, 3"),
+    ({"dimension": 2.0}, "dimension", "must be one of 2, 3"),
+    ({"name": 5}, "name", "must be a string"),
+    ({"description": ["a"]}, "description", "must be a string"),
+    ({"pinned": {"nodes": [1.5]}}, "pinned.nodes", "non-empty list of node indices"),
+    ({"pinned": {"nodes": []}}, "pinned.nodes", "non-empty list of node indices"),
+    ({"pinned": {"nodes": [True]}}, "pinned.nodes", "non-empty list of node indices"),
+    ({"rope": 5}, "rope", "must be a table, got 5"),
+    ({"initial": "hanging"}, "initial", "must be a table"),
+    ({"gravity": [1, 2]}, "gravity", "must be a table"),
+    ({"guides": 5}, "guides", "must be an array of tables ([[guides]])"),
+    ({"overrides": [5]}, "overrides.0", "must be a table"),
+    ({"rope__mass": math.nan}, "rope.mass", "must be a finite number"),
+    ({"rope__mass": math.inf}, "rope.mass", "must be a finite number"),
+    ({"rope__mass": 10 ** 400}, "rope.mass", "must be a finite number"),
+    ({"initial__top": [0, math.inf]}, "initial.top", "finite numbers"),
+    ({"initial__top": [0, 10 ** 400]}, "initial.top", "finite numbers"),
+]
+
+
+@pytest.mark.parametrize("changes,key,fragment", WRONG_TYPES)
+def test_wrong_types(changes, key, fragment):
+    refused(variant(LINE, **changes), key, fragment)
+
+
+OUT_OF_RANGE = [
+    ({"rope__mass": 0}, "rope.mass", "must be a number > 0 [kg], got 0.0"),
+    ({"rope__mass": -1}, "rope.mass", "> 0"),
+    ({"rope__nodes": 1}, "rope.nodes", "must be an integer >= 2"),
+    ({"rope__nodes": 10 ** 7}, "rope.nodes", "<= 1e+06"),
+    ({"rope__segment_length": 0.0}, "rope.segment_length", "> 0 [m]"),
+    ({"rope__stiffness": -5}, "rope.stiffness", "> 0 [N/m]"),
+    ({"integrator__dt": 0}, "integrator.dt", "must be a number > 0 [s]"),
+    ({"integrator__dt": -0.001}, "integrator.dt", "> 0"),
+    ({"integrator__t_end": -1}, "integrator.t_end", "must be a number >= 0 [s]"),
+    ({"drag": {"b": -0.1}}, "drag.b", "must be a number >= 0 [kg/s]"),
+    ({"gravity": {"g": -9.81}}, "gravity.g", ">= 0"),
+    ({"bending": {"stiffness": 0}}, "bending.stiffness", "> 0 [N/m]"),
+    ({"output": {"interval": 0}}, "output.interval", "> 0 [s]"),
+    ({"overrides": [{"index": 0, "mass": 0}]}, "overrides.0.mass", "> 0 [kg]"),
+    ({"overrides": [{"index": 0, "drag": -1}]}, "overrides.0.drag", ">= 0 [kg/s]"),
+    ({"overrides": [{"index": 5, "mass": 1}]}, "overrides.0.index", "past the rope's end: allowed -5 to 4"),
+    ({"overrides": [{"index": -6, "mass": 1}]}, "overrides.0.index", "allowed -5 to 4"),
+    ({"pinned": {"nodes": [0, 7]}}, "pinned.nodes[1]", "node index 7 is past the rope's end"),
+    ({"driven": [{"nodes": [-6], "velocity": [1, 0]}]}, "driven.0.nodes[0]", "past the rope's end"),
+    ({"integrator__t_end": 1e300}, "integrator.t_end", "at most 1e+12"),
+]
+
+
+@pytest.mark.parametrize("changes,key,fragment", OUT_OF_RANGE)
+def test_out_of_range(changes, key, fragment):
+    refused(variant(LINE, **changes), key, fragment)
+
+
+@pytest.mark.parametrize("dotted,key,fragment", [
+    ("thrower__length", "thrower.length", "> 0 [m]"),
+    ("thrower__width", "thrower.width", "> 0 [m]"),
+    ("thrower__b_thrower", "thrower.b_thrower", ">= 0 [kg/s]"),
+    ("thrower__omega0", "thrower.omega0", "> 0 [rad/s]"),
+    ("thrower__damping_ratio", "thrower.damping_ratio", ">= 0"),
+    ("guides__1__radius", "guides.1.radius", "> 0 [m]"),
+    ("guides__0__omega0", "guides.0.omega0", "> 0 [rad/s]"),
+])
+def test_out_of_range_in_the_shooter_parts(dotted, key, fragment):
+    refused(variant(LOOP, **{dotted: -1}), key, fragment)
+
+
+MISSING_PARTS = [
+    (variant(LINE, rope=DELETE), "rope", "missing: every scene needs a [rope] table"),
+    (variant(LINE, initial=DELETE), "initial", "missing: every scene needs a [initial] table"),
+    (variant(LINE, integrator=DELETE), "integrator", "missing"),
+    (variant(LINE, rope__mass=DELETE), "rope.mass", "missing: mass m of each node [kg]"),
+    (variant(LINE, rope__nodes=DELETE), "rope.nodes", "missing"),
+    (variant(LINE, integrator__dt=DELETE), "integrator.dt", "missing: time step [s]"),
+    (variant(LINE, integrator__t_end=DELETE), "integrator.t_end", "missing"),
+    (variant(LINE, initial__shape=DELETE), "initial.shape", "missing: one of 'hanging', 'line'"),
+    (variant(LINE, initial={"shape": "line", "start": [0, 0]}), "initial.end", "missing"),
+    (variant(LINE, initial={"shape": "points"}), "initial.points", "missing: one position per node"),
+    (variant(LINE, drag={}), "drag.b", "missing"),
+    (variant(LINE, bending={}), "bending.stiffness", "missing"),
+    (variant(LINE, pinned={}), "pinned.nodes", "missing"),
+    (variant(LINE, driven=[{"nodes": [0]}]), "driven.0.velocity", "missing: the constant velocity V [m/s]"),
+    (variant(LINE, overrides=[{"mass": 2.0}]), "overrides.0.index", "missing"),
+    (variant(LOOP, thrower__center=DELETE), "thrower.center", "missing"),
+    (variant(LOOP, thrower__v_max=DELETE), "thrower.v_max", "missing"),
+    (variant(LOOP, guides__1__radius=DELETE), "guides.1.radius", "missing"),
+]
+
+
+@pytest.mark.parametrize("raw,key,fragment", MISSING_PARTS)
+def test_missing_tables_and_keys(raw, key, fragment):
+    refused(raw, key, fragment)
+
+
+CROSS_FIELD = [
+    (variant(LINE, pinned={"nodes": [0]}, driven=[{"nodes": [-5], "velocity": [1, 0]}]), "driven.0.nodes[0]",
+     "node 0 is already held by pinned.nodes[0]; a node is pinned or driven, not both"),
+    (variant(LINE, driven=[{"nodes": [1], "velocity": [1, 0]}, {"nodes": [1], "velocity": [0, 1]}]),
+     "driven.1.nodes[0]", "already held by driven.0.nodes[0]"),
+    (variant(LINE, pinned={"nodes": [4, -1]}), "pinned.nodes[1]", "node 4 is listed twice (also pinned.nodes[0])"),
+    (variant(LINE, pinned={"nodes": [0, 1, 2, 3, 4]}), "pinned", "every node is held"),
+    (variant(LINE, overrides=[{"index": 4, "mass": 2}, {"index": -1, "drag": 2}]), "overrides.1.index",
+     "node 4 is already overridden by overrides.0; give each node one entry"),
+    (variant(LINE, overrides=[{"index": 1}]), "overrides.0", "sets neither mass nor drag"),
+    (variant(LINE, initial={"shape": "square_loop", "top_center": [0, 0]}), "initial.shape",
+     "'square_loop' needs a closed loop (rope.closed = true)"),
+    (variant(LINE, rope__closed=True), "initial.shape", "'hanging' makes an open line"),
+    (variant(LINE, rope__closed=True, initial={"shape": "line", "start": [0, 0], "end": [1, 0]}), "initial.shape",
+     "'line' makes an open line"),
+    (variant(LINE, rope__nodes=2, rope__closed=True, initial={"shape": "points", "points": [[0, 0], [1, 0]]}),
+     "rope.nodes", "a closed loop needs at least 3 nodes, got 2"),
+    (variant(LOOP, thrower=DELETE, guides=DELETE), "initial.top_center",
+     "missing: needed when there is no [thrower]"),
+    (variant(LOOP, thrower=DELETE, initial__top_center=[0, 0]), "guides.0.omega0",
+     "missing: needed when there is no [thrower]"),
+    (variant(LINE, initial={"shape": "points", "points": [[0, 0], [0, 1], [0, 2]]}), "initial.points",
+     "has 3 points but rope.nodes is 5; give one per node"),
+    (variant(LINE, initial={"shape": "points", "points": [[0, 0], [0, 1], [0, 1], [0, 3], [0, 4]]}),
+     "initial.points", "nodes 1 and 2 coincide"),
+    (variant(LINE, rope__closed=True, initial={"shape": "points", "points": [[0, 0], [1, 0], [1, 1], [0, 1],
+                                                                             [0, 0]]}),
+     "initial.points", "nodes 4 and 0 coincide"),
+    (variant(LINE, initial={"shape": "points", "points": [[0, 0], [0, 1], [0, 2], [0, 3], [0, 4, 5]]}),
+     "initial.points[4]", "list of 2 finite numbers"),
+    (variant(LINE, initial={"shape": "line", "start": [1, 2], "end": [1, 2]}), "initial.end",
+     "equals initial.start"),
+    (variant(LOOP, rope__nodes=4, bending={"stiffness": 1.0}), "bending",
+     "bending springs on a loop need at least 5 nodes"),
+    (variant(LINE, rope__nodes=2, bending={"stiffness": 1.0}), "bending", "need at least 3 nodes on a line, got 2"),
+    (variant(LOOP, thrower__v_max=0), "thrower.omega0", "default 4 pi |v_max| / length is 0 rad/s"),
+    (variant(LOOP, thrower__v_max=1e300, thrower__length=1e-300), "thrower.omega0", "is inf rad/s"),
+    (variant(LINE, integrator__dt=1e-9, integrator__t_end=1e4), "integrator.t_end", "t_end / dt = 1e+13 steps"),
+    (variant(LINE, name=""), "name", "must be a plain folder name"),
+    (variant(LINE, name="../elsewhere"), "name", "without / or \\"),
+    (variant(LINE, name=".."), "name", "not '.' or '..'"),
+    (variant(LINE, name="a\u0000b"), "name", "printable"),
+]
+
+
+@pytest.mark.parametrize("raw,key,fragment", CROSS_FIELD)
+def test_rules_across_keys(raw, key, fragment):
+    refused(raw, key, fragment)
+
+
+def test_invalid_toml_is_one_line():
+    with pytest.raises(SceneError) as info:
+        load("[rope]\nnodes = \n", source="bad.toml")
+    assert "not valid TOML" in assert_one_line(info.value, "bad.toml")
+    with pytest.raises(SceneError) as info:
+        load('name = "a"\nname = "b"\n', source="dup.toml")
+    assert "not valid TOML" in assert_one_line(info.value, "dup.toml")
+
+
+def test_file_problems(tmp_path):
+    for path, fragment in [(tmp_path / "nope.toml", "no such scene file"), (tmp_path, "is a folder")]:
+        with pytest.raises(SceneError) as info:
+            load_scene(path)
+        assert fragment in assert_one_line(info.value, str(path))
+    binary = tmp_path / "binary.toml"
+    binary.write_bytes(b"\xff\xfe\x00rope")
+    with pytest.raises(SceneError) as info:
+        load_scene(binary)
+    assert "cannot be read" in assert_one_line(info.value, str(binary))
+    good = tmp_path / "good_name.toml"
+    good.write_text(tomli_w.dumps(LINE))
+    assert load_scene(good).name == "good_name"  # the file's stem when the scene has no name
+
+
+# ------------------------------------------------------------------------------------ --set overrides
+
+
+@pytest.mark.parametrize("item,path,value", [
+    ("integrator.dt=0.002", ["integrator", "dt"], 0.002),
+    ("rope.nodes=61", ["rope", "nodes"], 61),
+    ("rope.closed=true", ["rope", "closed"], True),
+    ("initial.top=[1, -2.5]", ["initial", "top"], [1, -2.5]),
+    ("integrator.method=verlet", ["integrator", "method"], "verlet"),
+    ('name="two words"', ["name"], "two words"),
+    ("description = a sentence, unquoted ", ["description"], "a sentence, unquoted"),
+    ("gravity.g=1e1", ["gravity", "g"], 10.0),
+    ("guides.1.one_sided=false", ["guides", "1", "one_sided"], False),
+    ("integrator.dt=", ["integrator", "dt"], ""),
+])
+def test_parse_override_types_values_like_toml(item, path, value):
+    parts, parsed = parse_override(item)
+    assert parts == path and parsed == value and type(parsed) is type(value)
+
+
+def test_set_reaches_into_arrays_of_tables_and_adds_entries():
+    scene = load(LOOP, sets=["guides.1.one_sided=true", "guides.0.radius=0.25", "rope.nodes=12",
+                             "overrides.0.index=-1", "overrides.0.mass=3", "overrides.1.index=0",
+                             "overrides.1.drag=0.5", "gravity.g=9.8", "guides.0.center.1=0.5"])
+    assert [g.one_sided for g in scene.guides] == [False, True]
+    assert scene.guides[0].radius == 0.25 and scene.guides[0].center == (-1.0, 0.5)
+    assert scene.rope.nodes == 12 and scene.gravity.g == 9.8
+    assert scene.overrides == (S.NodeOverride(index=-1, mass=3.0), S.NodeOverride(index=0, drag=0.5))
+    scene = load(LOOP, sets=["guides.2.center=[0, 5]", "guides.2.radius=1"])
+    assert len(scene.guides) == 3 and scene.guides[2].center == (0.0, 5.0)
+
+
+def test_apply_override_edits_the_raw_dict():
+    raw = copy.deepcopy(LOOP)
+    apply_override(raw, "guides.0.omega0=7")
+    apply_override(raw, "driven.0.nodes=[0]")
+    assert raw["guides"][0]["omega0"] == 7 and raw["driven"] == [{"nodes": [0]}]
+
+
+SET_REFUSALS = [
+    ("rope.nodes", "--set", "expected KEY=VALUE"),
+    ("=5", "--set", "expected KEY=VALUE"),
+    ("rope.mass.x=1", "rope.mass", "is a value, not a table"),
+    ("guides.x.radius=1", "guides.x", "is a list; address its entries by number"),
+    ("guides.5.radius=1", "guides.5", "has 2 entries; --set can change one of them or add entry 2"),
+    ("guides.²=1", "guides.²", "is a list"),
+    ("rope.nodes=1", "rope.nodes", "must be an integer >= 2"),
+    ("rope.node=5", "rope.node", "did you mean 'nodes'?"),
+    ("integrator.dt=fast", "integrator.dt", "must be a number > 0 [s], got 'fast'"),
+    ("integrator.dt=", "integrator.dt", "got ''"),
+    ("guides.0=5", "guides.0", "must be a table"),
+    ("rope=5", "rope", "must be a table"),
+    ("overrides.1.mass=2", "overrides.0.index", "missing"),
+]
+
+
+@pytest.mark.parametrize("item,key,fragment", SET_REFUSALS)
+def test_bad_set_is_one_line(item, key, fragment):
+    with pytest.raises(SceneError) as info:
+        load(LOOP, sets=[item])
+    text = assert_one_line(info.value)
+    assert info.value.key == key, text
+    assert fragment in text, text
+    assert text.startswith(SOURCE), text
+
+
+# -------------------------------------------------------------------------------- resolved scene.toml
+
+
+@pytest.mark.parametrize("path", SCENARIO_FILES, ids=lambda p: p.stem)
+def test_resolved_scene_loads_back_equal_and_is_a_fixed_point(path):
+    scene = load_scene(path)
+    text = S.scene_to_toml(scene)
+    again = scene_from_toml(text, source="scene.toml", default_name="another_name")
+    assert again == scene
+    assert S.scene_to_toml(again) == text
+
+
+@pytest.mark.parametrize("path", SCENARIO_FILES, ids=lambda p: p.stem)
+def test_resolved_scene_shows_every_key_of_its_parts(path):
+    """Every key a user can set in a declared part is written out (only unset per-node overrides stay out)."""
+    resolved = tomllib.loads(S.scene_to_toml(load_scene(path)))
+    assert set(S.TOP_LEVEL_SCALARS) - {"description"} <= set(resolved)
+    for key, cls in {**S.TABLES, **S.ARRAYS_OF_TABLES}.items():
+        if key not in resolved:
+            continue
+        if key == "initial":
+            cls = S.INITIAL_SHAPES[resolved["initial"]["shape"]]
+        tables = resolved[key] if isinstance(resolved[key], list) else [resolved[key]]
+        for table in tables:
+            expected = {f.name for f in fields(cls) if "spec" in f.metadata or f.name == "shape"}
+            if cls is S.NodeOverride:
+                expected -= {"mass", "drag"} - set(table)
+            assert set(table) == expected, key
+
+
+def test_round_trip_of_the_shapes_not_in_scenarios():
+    for raw in (LINE, LOOP, variant(LINE, dimension=3, initial={"shape": "line", "start": [0, 0, 0],
+                                                                 "end": [1, 1, 1]}),
+                variant(LINE, initial={"shape": "points", "points": [[0, 0], [0, 1], [0, 2], [0, 3], [1e-9, 4]]},
+                        overrides=[{"index": -1, "mass": 2.0}], pinned={"nodes": 0})):
+        scene = load(raw)
+        assert load(S.scene_to_toml(scene)) == scene
+
+
+# ------------------------------------------------------------------------------ property-based tests
+
+VALID_RAWS = [tomllib.loads(p.read_text()) for p in SCENARIO_FILES] + [LINE, LOOP]
+KEY_WORDS = sorted({*S.TOP_LEVEL_SCALARS, *S.TABLES, *S.ARRAYS_OF_TABLES, "shape",
+                    *(f.name for cls in [*S.TABLES.values(), *S.ARRAYS_OF_TABLES.values(), *S.INITIAL_SHAPES.values()]
+                      if cls is not None for f in fields(cls))})
+EDGE_NUMBERS = [0, -1, 1, 2, 3, 4, 2 ** 63 - 1, -(2 ** 63), 10 ** 30, 10 ** 400, -(10 ** 400), 1_000_001,
+                0.0, -0.0, 1e-300, 5e-324, 1e300, 1e308, -1e308, math.nan, math.inf, -math.inf, 1e-9, 0.5, -2.5]
+
+numbers = st.one_of(st.sampled_from(EDGE_NUMBERS), st.integers(-10, 100), st.floats())
+scalars = st.one_of(numbers, st.booleans(), st.text(max_size=8), st.sampled_from(list(S.INITIAL_SHAPES)))
+keys = st.one_of(st.sampled_from(KEY_WORDS), st.text(min_size=1, max_size=8),
+                 st.sampled_from(["0", "1", "2", "-1", "01", "\u00b2", "\uff11", "", " "]))
+values = st.recursive(
+    scalars,
+    lambda inner: st.one_of(st.lists(inner, max_size=4), st.dictionaries(keys, inner, max_size=3)),
+    max_leaves=8,
+)
+
+
+def _slots(obj, path=()):
+    """Every (container, key or index) inside a raw scene, depth first."""
+    items = obj.items() if isinstance(obj, dict) else enumerate(obj)
+    for k, v in items:
+        yield obj, k
+        if isinstance(v, (dict, list)):
+            yield from _slots(v, path + (k,))
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+@st.composite
+def perturbed_scenes(draw):
+    """A valid scene with one to three of its numbers replaced by edge values (zero, negative, huge, nan...)."""
+    raw = copy.deepcopy(draw(st.sampled_from(VALID_RAWS)))
+    numeric = [(box, k) for box, k in _slots(raw) if _is_number(box[k])]
+    for _ in range(draw(st.integers(1, 3))):
+        box, k = draw(st.sampled_from(numeric))
+        box[k] = draw(numbers)
+    return raw
+
+
+@st.composite
+def mutated_scenes(draw):
+    """A valid scene with one to four random edits: delete, retype, renumber, add unknown keys, nest."""
+    raw = copy.deepcopy(draw(st.sampled_from(VALID_RAWS)))
+    for _ in range(draw(st.integers(1, 4))):
+        slots = list(_slots(raw))
+        action = draw(st.sampled_from(["delete", "replace", "number", "number", "add", "nest"]))
+        box, k = draw(st.sampled_from(slots)) if slots else (raw, None)
+        if action == "add" or k is None:
+            target = box[k] if k is not None and isinstance(box[k], (dict, list)) else box
+            if isinstance(target, dict):
+                target[draw(keys)] = draw(values)
+            else:
+                target.append(draw(values))
+        elif action == "delete":
+            del box[k]
+        elif action == "replace":
+            box[k] = draw(values)
+        elif action == "number":
+            box[k] = draw(numbers)
+        else:  # wrap the value in a list or a table
+            box[k] = draw(st.sampled_from([lambda v: [v], lambda v: {"x": v}, lambda v: {str(k): v}]))(box[k])
+    return raw
+
+
+def _accepted_or_one_line(text: str, sets=()):
+    try:
+        scene = scene_from_toml(text, source="fuzz.toml", default_name="fuzz", overrides=sets)
+    except SceneError as exc:
+        assert_one_line(exc, "fuzz.toml")
+        return None
+    model = build(scene)
+    assert model.x0.shape == (scene.dimension, scene.rope.nodes)
+    TimeGrid.of(scene)
+    assert scene_from_toml(S.scene_to_toml(scene), source="again.toml") == scene
+    return scene
+
+
+FUZZ = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+@FUZZ
+@given(mutated_scenes())
+def test_mutated_scenes_are_accepted_or_refused_in_one_line(raw):
+    _accepted_or_one_line(tomli_w.dumps(raw))
+
+
+@FUZZ
+@given(perturbed_scenes())
+def test_scenes_with_edge_numbers_are_accepted_or_refused_in_one_line(raw):
+    _accepted_or_one_line(tomli_w.dumps(raw))
+
+
+@FUZZ
+@given(st.sampled_from(VALID_RAWS), st.lists(st.tuples(st.lists(keys, min_size=1, max_size=4), values),
+                                             min_size=1, max_size=3))
+def test_random_set_overrides_are_accepted_or_refused_in_one_line(raw, items):
+    sets = []
+    for path, value in items:
+        text = tomli_w.dumps({"v": value}).partition("=")[2].strip() if not isinstance(value, dict) else "{}"
+        sets.append(".".join(path) + "=" + text)
+    _accepted_or_one_line(tomli_w.dumps(raw), sets)
+
+
+@FUZZ
+@given(st.lists(st.text(max_size=6), max_size=3))
+def test_random_set_strings_never_crash(sets):
+    _accepted_or_one_line(tomli_w.dumps(LINE), sets)
+
+
+toml_lines = st.one_of(
+    st.builds(lambda k: f"[{k}]", st.sampled_from(KEY_WORDS)),
+    st.builds(lambda k: f"[[{k}]]", st.sampled_from(KEY_WORDS)),
+    st.builds(lambda k, v: f"{k} = {v}", st.sampled_from(KEY_WORDS),
+              st.sampled_from(["1", "-3", "0.5", "nan", "inf", "1e400", "true", '"hanging"', '"square_loop"',
+                               "[0, 0]", "[1, 2, 3]", "[[0, 0], [1, 0]]", "{}", "{ a = 1 }", "'x'", "[]", "1979-05-27",
+                               "99999999999999999999999999"])),
+    st.text(max_size=20),
+)
+
+
+@FUZZ
+@given(st.lists(toml_lines, max_size=12))
+def test_random_toml_ish_text_never_crashes(lines):
+    _accepted_or_one_line("\n".join(lines))
+
+
+# -------------------------------------------------------------------------------- the README schema
+
+
+def _readme_section() -> str:
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    match = re.search(r"^## Scene files\n(.*?)(?=^## |\Z)", text, flags=re.M | re.S)
+    assert match, "README.md has no '## Scene files' section"
+    return match.group(1)
+
+
+def _subsections(section: str) -> dict[str, str]:
+    """The '### ...' subsections of the README section by heading."""
+    parts = re.split(r"^### (.*)$", section, flags=re.M)
+    return {parts[i].strip(): parts[i + 1] for i in range(1, len(parts), 2)}
+
+
+def _rows(body: str) -> dict[str, str]:
+    """Reference-table rows keyed by their first cell's `key`."""
+    return {m.group(1): m.group(0) for m in re.finditer(r"^\| `([a-z_0-9]+)` \|.*$", body, flags=re.M)}
+
+
+def _schema() -> dict[str, list[tuple[str, S.Spec, object]]]:
+    """Every key of the schema as (name, spec, default or None), by the README heading that documents it."""
+    def keys(cls):
+        return [(f.name, f.metadata["spec"], None if f.default is MISSING else f.default)
+                for f in fields(cls) if "spec" in f.metadata]
+
+    out = {"top-level keys": [(name, sp, None) for name, sp in S.TOP_LEVEL_SCALARS.items()]}
+    tables = {**{k: v for k, v in S.TABLES.items() if v is not None}, **S.ARRAYS_OF_TABLES}
+    for key, cls in tables.items():
+        out[f"[[{key}]]" if key in S.ARRAYS_OF_TABLES else f"[{key}]"] = keys(cls)
+    out["[initial]"] = [("shape", S.Spec("str", "", choices=tuple(S.INITIAL_SHAPES)), None)] + [
+        item for cls in S.INITIAL_SHAPES.values() for item in keys(cls)]
+    return out
+
+
+def _shown(default) -> str:
+    if isinstance(default, bool):
+        return str(default).lower()
+    return f"{default:g}" if isinstance(default, float) else str(default)
+
+
+def test_readme_documents_every_key_of_the_schema():
+    """Each table has a '### `[table]`' subsection with a row per key giving its unit, choices and default."""
+    subsections = _subsections(_readme_section())
+    for heading, keys in _schema().items():
+        matching = [body for title, body in subsections.items() if heading.lower() in title.lower()]
+        assert matching, f"README 'Scene files' has no '### ...{heading}...' subsection"
+        rows = _rows(matching[0])
+        for name, sp, default in keys:
+            assert name in rows, f"README {heading}: no row for `{name}`"
+            cells = [c.strip() for c in re.split(r"(?<!\\)\|", rows[name].strip())[1:-1]]  # \| is no border
+            assert len(cells) == 5, f"README {heading} `{name}`: expected key | type | unit | default | meaning"
+            _, kind, unit, shown_default, meaning = cells
+            assert unit == sp.unit, f"README {heading} `{name}`: unit {unit!r}, the schema says {sp.unit!r}"
+            for choice in sp.choices:
+                assert str(choice) in kind, f"README {heading} `{name}`: choice {choice} missing"
+            if sp.required and heading != "[initial]":
+                assert shown_default == "required", f"README {heading} `{name}` is required"
+            if default is not None:
+                assert _shown(default) in shown_default, f"README {heading} `{name}`: default {default}"
+            assert meaning, f"README {heading} `{name}`: no meaning"
+        assert set(rows) <= {name for name, _, _ in keys}, f"README {heading} documents unknown keys"
+
+
+def test_readme_examples_are_valid_scenes():
+    """Each ```toml block of the section is a complete scene, or a fragment that loads on top of a base one."""
+    blocks = re.findall(r"```toml\n(.*?)```", _readme_section(), flags=re.S)
+    assert len(blocks) >= 10
+    base = copy.deepcopy(LINE)
+    base["rope"]["nodes"] = 21
+    for block in blocks:
+        fragment = tomllib.loads(block)
+        raw = fragment if "rope" in fragment and "integrator" in fragment else {**base, **fragment}
+        try:
+            load(raw, source="README")
+        except SceneError as exc:
+            pytest.fail(f"README example does not load: {exc}\n{block}")
