@@ -21,7 +21,7 @@ from ropesim.build import build
 from ropesim.render import RenderError, framing
 from ropesim.render.animate import FrameRenderer, animate
 from ropesim.render.encode import gif_fps, gif_palette
-from ropesim.render.frames import frame_sheet
+from ropesim.render.frames import HEADER_ROOM, frame_sheet
 from ropesim.render.framing import (Band, Box, Circle, fit_box, followed_nodes, outline, projection,
                                     single_view, view_box)
 from ropesim.render.plots import largest_stretch_series, per_frame, plot_run
@@ -108,7 +108,7 @@ def test_animation_plan_takes_the_nearest_frames_at_the_requested_rate(frames, i
 ])
 def test_animation_plan_rejects_impossible_requests(kwargs, fragment):
     t = np.linspace(0, 1, 101)
-    with pytest.raises(RenderError, match=None) as err:
+    with pytest.raises(RenderError) as err:
         animation_plan(t, **{"fps": 25, **kwargs})
     assert fragment in str(err.value) and "\n" not in str(err.value)
 
@@ -357,16 +357,10 @@ def test_frame_sheet_png_size_times_and_determinism(runs, tmp_path):
     # two rows of the same panels are about twice as tall as one
     one = frame_sheet(traj, tmp_path / "c.png", count=2, columns=2, width=600).size
     two = frame_sheet(traj, tmp_path / "d.png", count=4, columns=2, width=600).size
-    assert two[1] - framing_header() == pytest.approx(2 * (one[1] - framing_header()), abs=2)
+    assert two[1] - HEADER_ROOM == pytest.approx(2 * (one[1] - HEADER_ROOM), abs=2)
     over = frame_sheet(runs["towed3d"], tmp_path / "e.png", overlay=True, follow=True, view="xz")
     with Image.open(tmp_path / "e.png") as png:
         assert png.size == over.size
-
-
-def framing_header() -> int:
-    from ropesim.render.frames import HEADER_ROOM
-
-    return HEADER_ROOM
 
 
 # ------------------------------------------------------------------------------------------ plots
@@ -374,9 +368,11 @@ def framing_header() -> int:
 
 def test_plots_choose_panels_by_scene_and_match_the_analyses(runs, tmp_path, monkeypatch):
     heli, shooter = runs["heli"], runs["shooter"]
-    assert plot_run(heli, tmp_path / "h.png").panels == ("energy", "stretch", "towed")
+    every = {"energy", "stretch"}  # and whatever else every run gets
+    towed = plot_run(heli, tmp_path / "h.png").panels
+    assert every <= set(towed) and "towed" in towed and "shooter" not in towed
     plot = plot_run(shooter, tmp_path / "s.png")
-    assert plot.panels == ("energy", "stretch", "shooter")
+    assert every <= set(plot.panels) and "shooter" in plot.panels and "towed" not in plot.panels
     with Image.open(tmp_path / "s.png") as png:
         assert png.size == plot.size
     model = build(heli.scene)

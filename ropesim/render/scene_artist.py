@@ -21,6 +21,7 @@ from .framing import BAND_REACH, Band, Box, Circle, Projection, outline
 
 ROPE_COLOR = "#1f77b4"
 NODE_SIZE = 2.6          # [pt] marker of an ordinary node
+MARKED_NODES = 200       # ropes with more nodes are drawn as a plain line: markers would merge into a band
 HEAVY_MAX_SCALE = 4.0    # a heavy node's marker grows as sqrt(mass ratio), at most this many times
 CANOPY = Path.wedge(0.0, 180.0)  # the parachute marker: a half disc, open side down
 GEOMETRY = {"facecolor": "0.9", "edgecolor": "0.45", "linewidth": 1.0}
@@ -117,7 +118,8 @@ class RopeArtist:
         self.shift, transform = _shifted(ax)
         self.cols = list(proj.axes)
         self.closed = model.scene.rope.closed
-        self.line = Line2D([], [], color=color, linewidth=1.4, marker="o", markersize=NODE_SIZE, alpha=alpha,
+        marker = "o" if model.nodes <= MARKED_NODES else "None"
+        self.line = Line2D([], [], color=color, linewidth=1.4, marker=marker, markersize=NODE_SIZE, alpha=alpha,
                            zorder=3)
         self.special = [(idx, Line2D([], [], linestyle="none", alpha=alpha, **style))
                         for _, idx, style in special_nodes(model)]
