@@ -131,7 +131,8 @@ def sweep(
                                          "repeatable.")] = None,
     scheduler: Annotated[Optional[str], typer.Option(
         "--scheduler", metavar="ADDRESS", help="Send the runs to this Dask scheduler (tcp://host:8786) "
-                                               "instead of local processes; needs ropesim[dask].")] = None,
+                                               "instead of local processes; needs the dask extra "
+                                               "(dask.distributed).")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")] = False,
 ) -> None:
     """Run a scene for every combination of --set values, in parallel; rerun, it resumes.

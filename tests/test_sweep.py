@@ -288,3 +288,38 @@ def test_range_count_is_the_number_of_runs(count):
     """The count in start:stop:count is how many runs a swept key contributes."""
     axis = parse_axis(f"drag.b=0.1:1.5:{count}")
     assert len(axis.values) == count and axis.swept
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_the_runs_cleanly_and_the_table_says_so(tmp_path):
+    """Ctrl-C (SIGINT to the terminal's process group): runs stop at their next chunk, keep their frames, and
+    the table marks them interrupted, so a rerun would run them again; exit code 130."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "sweep"
+    cmd = [sys.executable, "-m", "ropesim", "sweep", str(UNIFORM), "--out", str(out), "-j", "2",
+           "--set", "drag.b=4,6", "--set", "integrator.t_end=1e6", "--set", "output.interval=10"]
+    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 180
+        while len(list(out.glob("*/.frames-*"))) < 2:  # both runs are streaming frames: they are integrating
+            assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+            time.sleep(0.2)
+        time.sleep(0.5)
+        os.killpg(proc.pid, signal.SIGINT)
+        _, stderr = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 130, stderr
+    assert "sweep interrupted; rerun the same command to finish it" in stderr
+    rows = read_table(out / "results.csv")
+    assert [r["status"] for r in rows] == ["interrupted", "interrupted"]
+    for row in rows:
+        assert row["error"].startswith("interrupted at t = ")
+        traj = ropesim.Trajectory.open(out / row["run"])
+        assert traj.t[-1] < 1e6 and np.all(np.isfinite(traj.x))  # the frames up to the stop, kept
+        assert not list((out / row["run"]).glob(".frames-*"))  # streaming files cleaned up
