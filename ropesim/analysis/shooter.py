@@ -41,4 +41,14 @@ def shooter_figures(model: Model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -
         "averaged_over_s": round(float(t[-1] - t[last[0]]), 6),
         "circulation_speed_m_s": round(float(circulation_speed(x[-1], v[-1])), 4),
         "drive_speed_m_s": model.scene.thrower.v_max,
+        "nodes_in_thrower": nodes_in_thrower(model, x[-1]),
     }
+
+
+def nodes_in_thrower(model: Model, x: np.ndarray) -> int:
+    """How many nodes of one frame (N, D) are inside the thrower box: 0 means the loop has fallen out."""
+    from ..forces.thrower import inside_box
+
+    xdn = np.ascontiguousarray(np.asarray(x).T)
+    box = model.forces[5]
+    return int(sum(inside_box(xdn, i, box) for i in range(xdn.shape[1])))
