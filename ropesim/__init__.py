@@ -15,13 +15,13 @@ from .numba_cache import ensure_writable_cache  # noqa: E402
 
 ensure_writable_cache()  # before any kernel is defined: a read-only install caches its kernels elsewhere
 
-__all__ = ["load_scene", "scene_from_toml", "SceneError", "Scene", "simulate", "build", "Trajectory",
-           "RunFolderError", "METHODS", "scene_to_toml"]
+__all__ = ["load_scene", "scene_from_toml", "SceneError", "Scene", "simulate", "Trajectory", "RunFolderError",
+           "METHODS", "scene_to_toml"]
 
 _LAZY = {
     "load_scene": "loader", "scene_from_toml": "loader", "SceneError": "loader",
     "Scene": "scene", "scene_to_toml": "scene",
-    "simulate": "run", "build": "build",
+    "simulate": "run",
     "Trajectory": "trajectory", "RunFolderError": "trajectory",
     "METHODS": "integrators",
 }
