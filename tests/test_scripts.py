@@ -72,15 +72,15 @@ def test_run_all_stops_loudly_on_a_missing_scene(tmp_path):
 
 
 def test_run_all_stops_loudly_when_a_run_fails(tmp_path):
-    """A run that blows up (dt far past the stability bound) stops the script with the run's exit code."""
+    """A run that fails (dt far past the stability bound: refused) stops the script with the run's exit code."""
     bad = tmp_path / "unstable.toml"
     text = (SCENARIOS / "helicopter_uniform.toml").read_text()
     bad.write_text(text.replace("dt = 0.001", "dt = 0.2").replace("interval = 0.01", "interval = 0.2")
                    .replace("t_end = 3.0", "t_end = 100.0"))
     result = run("run_all.sh", str(bad), env={"NO_ANIMATE": "1"}, cwd=tmp_path)
     assert result.returncode != 0
-    assert "blew up" in result.stderr
-    assert f"run_all.sh: ropesim run {bad} failed (exit 3)" in result.stderr
+    assert "stability bound" in result.stderr
+    assert f"run_all.sh: ropesim run {bad} failed (exit 2)" in result.stderr
 
 
 @pytest.mark.parametrize("script", ["run_all.sh", "sweep_air_resistance.sh"])
