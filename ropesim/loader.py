@@ -297,9 +297,6 @@ def _check_scene(scene: S.Scene, source: str) -> S.Scene:
         guides.append(guide)
     scene = replace(scene, guides=tuple(guides))
 
-    out = scene.output
-    if out.interval < scene.integrator.dt:
-        fail("output.interval", f"must be at least integrator.dt = {scene.integrator.dt:g} s, got {out.interval:g}")
     return scene
 
 
