@@ -382,7 +382,12 @@ def stability(
 
 
 def main() -> None:
-    app()
+    """Entry point. A Ctrl-C outside a run's own clean stop (say, while Python imports) is one line too."""
+    try:
+        app()
+    except KeyboardInterrupt:
+        typer.echo("ropesim: interrupted", err=True)
+        sys.exit(EXIT_INTERRUPTED)
 
 
 if __name__ == "__main__":  # pragma: no cover
