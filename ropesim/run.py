@@ -25,6 +25,7 @@ from .scene import Scene
 
 COMPLETED, INTERRUPTED, BLEW_UP = "completed", "interrupted", "blew_up"
 CHECK_EVERY = 64  # steps between finiteness checks: a blow-up is caught within this many steps
+FRAME_BUFFER_BYTES = 16 * 2 ** 20  # at most this many bytes of saved frames are held in memory between chunks
 
 
 @dataclass(frozen=True)
@@ -261,6 +262,7 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
         status, bad_node, message, code = "completed", -1, "", OK
         chunk = max(1, min(grid.steps, 20_000_000 // max(1, model.nodes * stepper.scheme.evaluations)))
         chunk = _round_to(chunk, grid.save_every)
+        frame_cap = grid.save_every * max(1, FRAME_BUFFER_BYTES // (2 * 8 * model.nodes * model.dim))
         compile_time = stepper.warm_up()
         start = time.perf_counter()
         while stepper.step < grid.steps:
@@ -268,7 +270,7 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
                 status = INTERRUPTED
                 message = f"interrupted at t = {stepper.t:.6g} s (step {stepper.step} of {grid.steps})"
                 break
-            n = min(chunk, grid.steps - stepper.step)
+            n = min(chunk, frame_cap, grid.steps - stepper.step)
             frames = stepper.new_frames(n)
             tick = time.perf_counter()
             done, written, code, node = stepper.advance(n, frames)

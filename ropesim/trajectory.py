@@ -45,6 +45,23 @@ def write_json_atomic(path: Path, data: dict) -> None:
     write_text_atomic(path, json.dumps(data, indent=2, sort_keys=False) + "\n")
 
 
+WRITE_BLOCK_BYTES = 16 * 2 ** 20  # an array is written this many bytes at a time, never copied whole
+
+
+def _write_npy(fh, arr) -> None:
+    """Write ``arr`` in .npy format to ``fh``, a block of leading rows at a time (a memory map is read lazily)."""
+    arr = np.asarray(arr)
+    if not arr.flags.c_contiguous:
+        arr = np.ascontiguousarray(arr)
+    np.lib.format.write_array_header_1_0(fh, np.lib.format.header_data_from_array_1_0(arr))
+    if arr.ndim == 0 or arr.size == 0:
+        fh.write(arr.tobytes())
+        return
+    rows = max(1, WRITE_BLOCK_BYTES // max(1, arr[0].nbytes))
+    for start in range(0, len(arr), rows):
+        fh.write(np.ascontiguousarray(arr[start:start + rows]).data)
+
+
 def write_npz_atomic(path: Path, arrays: dict[str, np.ndarray]) -> None:
     """Write an uncompressed, memory-mappable ``.npz`` atomically, streaming each array in chunks."""
     path = Path(path)
@@ -54,7 +71,7 @@ def write_npz_atomic(path: Path, arrays: dict[str, np.ndarray]) -> None:
         with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_STORED, allowZip64=True) as zf:
             for name, arr in arrays.items():
                 with zf.open(f"{name}.npy", "w", force_zip64=True) as fh:
-                    np.lib.format.write_array(fh, np.asarray(arr), allow_pickle=False)
+                    _write_npy(fh, arr)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

@@ -88,3 +88,52 @@ def test_a_compiled_kernel_loads_from_the_cache_in_a_fresh_process(scenarios):
                          env=dict(os.environ), timeout=600, check=True).stdout
     stats = json.loads(out.strip().splitlines()[-1])
     assert stats == {"hits": 1, "misses": 0}
+
+
+@pytest.mark.parametrize("shape", [(7, 40, 2), (3, 5, 33, 3), (40, 2), (1, 9, 2)])
+def test_spring_helpers_give_the_same_numbers_block_by_block(shape, monkeypatch):
+    from ropesim.forces import springs
+
+    x = np.random.default_rng(len(shape)).normal(size=shape)
+    whole = [springs.pair_spring_energy(x, 3.0, 0.5, 1, True), springs.pair_spring_stretch(x, 0.5, 2, False)]
+    monkeypatch.setattr(springs, "BLOCK_BYTES", x[..., :1, :, :].nbytes if x.ndim > 2 else 8)
+    blocked = [springs.pair_spring_energy(x, 3.0, 0.5, 1, True), springs.pair_spring_stretch(x, 0.5, 2, False)]
+    for a, b in zip(whole, blocked):
+        assert a.shape == b.shape == (shape[:-2] if a is whole[0] else shape[:-2] + (shape[-2] - 2,))
+        np.testing.assert_array_equal(a, b)
+
+
+def _traced_peak(fn) -> int:
+    """Peak bytes allocated through Python and NumPy while ``fn`` runs (file-backed memory maps excluded)."""
+    tracemalloc.start()
+    try:
+        fn()
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+def test_a_run_folder_does_not_hold_its_frames_in_memory(scenarios, tmp_path, monkeypatch):
+    """Eight times the saved frames (about 18 MB more trajectory) must not raise the peak by 1 MB.
+
+    The run loop holds at most FRAME_BUFFER_BYTES of frames between chunks, the rest go to disk, and the
+    summary reads them back in blocks of at most BLOCK_BYTES (all 256 kB here, so that 320 frames are many).
+    """
+    from ropesim import run as run_module
+    from ropesim.analysis import summary
+    from ropesim.forces import springs
+
+    for module, name in ((run_module, "FRAME_BUFFER_BYTES"), (summary, "BLOCK_BYTES"), (springs, "BLOCK_BYTES")):
+        monkeypatch.setattr(module, name, 256 * 1024)
+    nodes, steps = 2000, 1600
+    frame = nodes * 2 * 8
+
+    def run(frames: int):
+        scene = ropesim.load_scene(scenarios / "helicopter_uniform.toml", [
+            f"rope.nodes={nodes}", f"integrator.t_end={steps * 0.001}", f"output.interval={steps * 0.001 / frames}"])
+        return lambda: ropesim.simulate(scene, tmp_path / f"run{frames}")
+
+    run(2)()   # compile outside the measurement
+    few, many = _traced_peak(run(40)), _traced_peak(run(320))
+    assert 2 * (320 - 40) * frame > 17e6
+    assert many - few < 1e6, (few, many)

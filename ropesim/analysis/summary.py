@@ -12,14 +12,21 @@ from .energy import energy_terms
 from .towed import towed_end, towed_figures
 
 FRAME_BLOCK = 256  # frames per block when scanning a (possibly memory-mapped) trajectory
+BLOCK_BYTES = 16 * 2 ** 20  # and at most this many bytes of one array per block: a big rope's frames are big
+
+
+def block_frames(frame_nbytes: int, block: int | None = None) -> int:
+    """Frames per block: ``block`` (default FRAME_BLOCK), fewer when that many frames exceed BLOCK_BYTES."""
+    return max(1, min(block or FRAME_BLOCK, BLOCK_BYTES // max(1, frame_nbytes)))
 
 
 def largest_stretch(model: Model, x: np.ndarray) -> tuple[float, float]:
     """The largest relative spring stretch |r| / l - 1 over all saved frames, and the time index it occurs."""
     rope = model.scene.rope
     best, where = -np.inf, 0
-    for start in range(0, len(x), FRAME_BLOCK):
-        stretch = pair_spring_stretch(x[start:start + FRAME_BLOCK], rope.segment_length, 1, rope.closed)
+    block = block_frames(x[0].nbytes)
+    for start in range(0, len(x), block):
+        stretch = pair_spring_stretch(x[start:start + block], rope.segment_length, 1, rope.closed)
         per_frame = stretch.max(axis=1)
         k = int(np.argmax(per_frame))
         if per_frame[k] > best:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import RenderError
-from ..analysis.summary import FRAME_BLOCK
+from ..analysis.summary import FRAME_BLOCK, block_frames
 from ..build import Model
 
 AXIS_NAMES = "xyz"
@@ -136,10 +136,11 @@ def outline_extent(shapes: list) -> tuple[np.ndarray, np.ndarray]:
 # ------------------------------------------------------------------------------------------ limits
 
 
-def frame_blocks(frames: int, block: int | None = None):
-    """Slices covering ``range(frames)`` in blocks (default FRAME_BLOCK frames), for reading a memory-mapped
+def frame_blocks(frames: int, block: int | None = None, frame_nbytes: int = 0):
+    """Slices covering ``range(frames)`` in blocks (default FRAME_BLOCK frames, fewer for frames of
+    ``frame_nbytes`` bytes each when that many would exceed BLOCK_BYTES), for reading a memory-mapped
     trajectory lazily."""
-    block = block or FRAME_BLOCK
+    block = block_frames(frame_nbytes, block or FRAME_BLOCK)
     for start in range(0, frames, block):
         yield slice(start, min(start + block, frames))
 
@@ -148,7 +149,7 @@ def run_extent(x: np.ndarray, proj: Projection, nodes: np.ndarray | None) -> tup
     """Lower and upper corners [m] of every finite projected node position over all frames of ``x``."""
     lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
     cols = list(proj.axes)
-    for sl in frame_blocks(len(x)):
+    for sl in frame_blocks(len(x), frame_nbytes=x[0].nbytes):
         block = np.asarray(x[sl])
         p = (block - origin(block, nodes)[:, None, :])[:, :, cols]
         p = p[np.isfinite(p).all(axis=-1)]

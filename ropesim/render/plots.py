@@ -30,7 +30,8 @@ HEADER = 40          # [px] the title
 
 def per_frame(traj: Trajectory, fn: Callable[[np.ndarray, np.ndarray], np.ndarray | dict]):
     """``fn(x, v)`` over blocks of frames ((B, N, D) each), joined along the frame axis (arrays or dicts)."""
-    parts = [fn(np.asarray(traj.x[sl]), np.asarray(traj.v[sl])) for sl in frame_blocks(traj.frames)]
+    blocks = frame_blocks(traj.frames, frame_nbytes=traj.x[0].nbytes)
+    parts = [fn(np.asarray(traj.x[sl]), np.asarray(traj.v[sl])) for sl in blocks]
     if isinstance(parts[0], dict):
         return {key: np.concatenate([p[key] for p in parts]) for key in parts[0]}
     return np.concatenate(parts)
