@@ -83,7 +83,7 @@ class Stepper:
         self.ledger = np.zeros(LEDGER_SIZE)
         self.ledger[E0] = float(energy_terms(model, self.x.T, self.v.T)["total"])
         self.ledger[SCALE] = energy_scale(model)
-        self.limits = np.array([stretch_limit(model), RUNAWAY_FACTOR])
+        self.limits = np.array([stretch_limit(model), RUNAWAY_FACTOR, RUNAWAY_FLOW_FRACTION])
         self.held = (model.held_idx, model.held_x0, model.held_v)
         kind = self.scheme.kind
         if kind == "splitting":
@@ -173,7 +173,8 @@ class Stepper:
         return time.perf_counter() - start
 
 
-RUNAWAY_FACTOR = 1.0      # energy balance residual, in units of the energy in play, that counts as a blow-up
+RUNAWAY_FACTOR = 1.0      # a blow-up: energy balance off by this times the initial energy scale ...
+RUNAWAY_FLOW_FRACTION = 0.2  # ... plus this fraction of the energy that flowed in and out
 STRETCH_SANITY = 4.0      # a spring longer than this many rest lengths (or 4x its static strain) is a blow-up
 
 
@@ -308,8 +309,8 @@ def _blow_up_message(model: Model, stepper: Stepper, code: int, node: int) -> tu
         NON_FINITE: f"node {node} has a non-finite position or velocity",
         OVERSTRETCH: f"the spring after node {node} is stretched beyond {stepper.limits[0]:.3g} times its rest "
                      f"length",
-        RUNAWAY_ENERGY: f"runaway energy (the energy balance is off by more than {RUNAWAY_FACTOR:g} times the "
-                        f"energy in play; node {node} is the fastest)",
+        RUNAWAY_ENERGY: f"runaway energy (the energy balance is off by more than the initial energy scale plus "
+                        f"{RUNAWAY_FLOW_FRACTION:.0%} of the energy that flowed; node {node} is the fastest)",
         NEWTON_FAILED: f"the implicit stage's Newton solve did not converge in node {node}'s neighbourhood",
     }[code]
     bound = predicted_dt(model, method)

@@ -64,19 +64,19 @@ def ledger_series(model: Model, x: np.ndarray, v: np.ndarray, flows: np.ndarray,
 def ledger_summary(series: dict, energy0: float) -> dict:
     """The balance at the end: each flow, the residual, and the residual relative to the energy that flowed.
 
-    "Energy that flowed" is the largest D + |W_held| + |W_box| reached, or, in a closed system where nothing
-    flows, the largest change of any single energy term (the energy that moved between terms), so the
-    relative residual is always measured against energy that actually moved. ``residual_growth`` compares the
+    "Energy that flowed" is the largest D + |W_held| + |W_box| reached or, when larger (as in a closed system,
+    where nothing flows), the largest change of any single energy term (the energy that moved between terms),
+    so the relative residual is always measured against energy that actually moved. ``residual_growth`` compares the
     largest |residual| in the last and the first half of the run: well above 1 on a run that is going wrong.
     """
     residual = np.abs(series["residual"])
     flowed = series["drag_loss"] + np.abs(series["held_work"]) + np.abs(series["box_work"])
     moved = float(flowed.max()) if len(flowed) else 0.0
+    terms = [k for k in ("kinetic", "spring", "bending", "gravity") if k in series]
+    exchanged = max(float(np.ptp(series[k])) for k in terms) if len(residual) else 0.0
     basis = "flows"
-    if moved <= 0.0:
-        basis = "exchange"
-        terms = [k for k in ("kinetic", "spring", "bending", "gravity") if k in series]
-        moved = max(float(np.ptp(series[k])) for k in terms) if len(residual) else 0.0
+    if exchanged > moved:
+        basis, moved = "exchange", exchanged
     half = len(residual) // 2
     first = float(residual[:max(half, 1)].max()) if len(residual) else 0.0
     last = float(residual[half:].max()) if len(residual) else 0.0
