@@ -97,12 +97,12 @@ def build(scene: S.Scene) -> Model:
         centre = list(t.center) + [0.0] * (3 - dim)
         w = t.omega0
         thrower = np.array([*centre, t.length / 2, t.width / 2, t.v_max, t.b_thrower, w * w,
-                            2 * t.damping_ratio * w])
+                            2 * t.damping_ratio * w, t.edge_width])
     guides = np.zeros((0, GUIDE_PARAMS))
     if scene.guides:
         flags[GUIDES] = 1
         guides = np.array([[c.center[0], c.center[1], c.radius, c.omega0 * c.omega0, 2 * c.damping_ratio * c.omega0,
-                            1.0 if c.one_sided else 0.0] for c in scene.guides])
+                            1.0 if c.one_sided else 0.0, c.edge_width] for c in scene.guides])
 
     forces = (1.0 / mass, flags, spring, bending, gravity, thrower, guides)
     return Model(scene=scene, x0=x0, v0=v0, mass=mass, drag=drag, held=held, held_idx=held_idx,

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .forces.thrower import inside_box
+from .forces.thrower import box_weight, smooth_step
 from .health import BOX, DRAG, HELD, NEWTON_FAILED, OK, end_step, held_power, place_held, power
 from .kernel import BENDING, GUIDES, THROWER, accelerations, box_accelerations
 
@@ -245,28 +245,34 @@ def _assemble(x, v, band, corner, beta, mass, drag, free, forces, w, blk):
         diag = m + beta * drag[i]
         for d in range(dim):
             band[0, i * dim + d] += diag
-        in_box = False
+        outside = 1.0
         if flags[THROWER]:
-            in_box = inside_box(x, i, thrower)
-            if in_box:
-                band[0, i * dim] += beta * thrower[6]
+            sb = box_weight(x, i, thrower)
+            outside = 1.0 - sb
+            if sb > 0.0:
+                band[0, i * dim] += sb * beta * thrower[6]
                 for d in range(1, dim):
-                    band[0, i * dim + d] += m * (b2 * thrower[7] + beta * thrower[8])
-        if flags[GUIDES] and not in_box:
+                    band[0, i * dim + d] += sb * m * (b2 * thrower[7] + beta * thrower[8])
+        if flags[GUIDES] and outside > 0.0:
             for c in range(guides.shape[0]):
                 dx = x[0, i] - guides[c, 0]
                 dy = x[1, i] - guides[c, 1]
                 r = math.sqrt(dx * dx + dy * dy)
                 radius = guides[c, 2]
-                if r >= radius or r == 0.0:
+                weight = outside * smooth_step(radius - r, guides[c, 6])
+                if weight == 0.0 or r == 0.0:
                     continue
                 ux, uy = dx / r, dy / r
                 vr = v[0, i] * ux + v[1, i] * uy
-                if guides[c, 5] != 0.0 and vr > 0.0:
-                    continue
+                if guides[c, 5] != 0.0:
+                    if guides[c, 6] == 0.0:
+                        if vr > 0.0:
+                            continue
+                    else:
+                        weight *= smooth_step(-vr, guides[c, 6] * math.sqrt(guides[c, 3]))
                 ar = -guides[c, 3] * (r - radius) - guides[c, 4] * vr
-                radial = b2 * guides[c, 3] + beta * guides[c, 4]
-                tangential = b2 * max(0.0, -ar / r)
+                radial = weight * (b2 * guides[c, 3] + beta * guides[c, 4])
+                tangential = weight * b2 * max(0.0, -ar / r)
                 u = (ux, uy)
                 for a in range(2):
                     for b in range(a + 1):

@@ -184,6 +184,8 @@ class Thrower:
                                 "rad/s", default=None, required=False, low=0, open_low=True)
     damping_ratio: float = spec("float", "damping ratio zeta of the centring spring (1 = critical)", default=1.0,
                                 low=0)
+    edge_width: float = spec("float", "width w over which the box's edges switch its forces on (0 = sharp)", "m",
+                             default=0.0, low=0)
 
     @property
     def resolved_omega0(self) -> float:
@@ -205,6 +207,8 @@ class Guide:
                                 "rad/s", default=None, required=False, low=0, open_low=True)
     damping_ratio: float = spec("float", "damping ratio zeta of the radial spring", default=1.0, low=0)
     one_sided: bool = spec("bool", "let go of nodes moving outward", default=False)
+    edge_width: float = spec("float", "width w over which the rim switches the circle's forces on (0 = sharp)", "m",
+                             default=0.0, low=0)
 
 
 # --------------------------------------------------------------------------- time and output

@@ -5,15 +5,20 @@ is pushed out to the rim by a damped radial spring, a_r = -omega0^2 (r - R) - 2 
 weight is cancelled (a_y += g, once even inside two circles). A one-sided circle lets go of nodes moving
 outward (v_r > 0).
 
-Parameters: one row per circle, float64 (M, 6): cx, cy, R, omega0^2, 2 zeta omega0, one_sided (0 or 1).
+With an edge width w > 0 (``edge_width`` of the circle) the rim is smoothed: the circle's forces (spring,
+damping and lift) are weighted by S(R - r), S the thrower's smooth step of width w, times 1 - the box's weight,
+and a one-sided circle lets go smoothly, by S(-v_r) over a speed width w omega0. With w = 0 (the default) all
+are sharp, as above.
+
+Parameters: one row per circle, float64 (M, 7): cx, cy, R, omega0^2, 2 zeta omega0, one_sided (0 or 1), w.
 """
 
 import numpy as np
 from numba import njit
 
-from .thrower import inside_box
+from .thrower import box_weight, smooth_step
 
-GUIDE_PARAMS = 6
+GUIDE_PARAMS = 7
 
 
 @njit(cache=True, error_model="numpy")
@@ -21,23 +26,30 @@ def add_guides(x, v, acc, circles, box, has_box, g):
     """Add the guide circles' accelerations [m/s^2]; ``box`` is the thrower's parameters if ``has_box``."""
     n = x.shape[1]
     for i in range(n):
-        if has_box and inside_box(x, i, box):
+        outside = 1.0 - box_weight(x, i, box) if has_box else 1.0
+        if outside == 0.0:
             continue
-        lifted = False
+        lift = 0.0
         for c in range(circles.shape[0]):
             dx = x[0, i] - circles[c, 0]
             dy = x[1, i] - circles[c, 1]
             r = np.sqrt(dx * dx + dy * dy)
             radius = circles[c, 2]
-            if r >= radius:
+            w = circles[c, 6]
+            weight = smooth_step(radius - r, w)
+            if weight == 0.0:
                 continue
             if r > 0.0:
                 vr = (v[0, i] * dx + v[1, i] * dy) / r
-                if circles[c, 5] != 0.0 and vr > 0.0:
-                    continue
-                ar = -circles[c, 3] * (r - radius) - circles[c, 4] * vr
+                if circles[c, 5] != 0.0:
+                    if w == 0.0:
+                        if vr > 0.0:
+                            continue
+                    else:
+                        weight *= smooth_step(-vr, w * np.sqrt(circles[c, 3]))
+                ar = outside * weight * (-circles[c, 3] * (r - radius) - circles[c, 4] * vr)
                 acc[0, i] += ar * dx / r
                 acc[1, i] += ar * dy / r
-            if not lifted:
-                acc[1, i] += g
-                lifted = True
+            lift = max(lift, weight)
+        if lift > 0.0:
+            acc[1, i] += outside * lift * g

@@ -4,12 +4,45 @@ A node inside the box |x - cx| < L/2, |y - cy| < W/2 (and |z - cz| < W/2 in 3-D)
 towards v_max, F_x = b_thrower (v_max - v_x), and held to the centre line by a damped spring that also
 cancels its weight: a_y = g - omega0^2 (y - cy) - 2 zeta omega0 v_y (likewise in z, without g).
 
-Parameters, packed in one float64 array: cx, cy, cz, L/2, W/2, v_max, b_thrower, omega0^2, 2 zeta omega0.
+With an edge width w > 0 (``thrower.edge_width``) the box's edges are smoothed: each force is weighted by
+S(L/2 - |x - cx|) S(W/2 - |y - cy|) [S(W/2 - |z - cz|)], with S(d) = (1 + tanh(d / w)) / 2, a smooth step of
+width w instead of the sharp in-or-out (w = 0, the default). Smooth forces let higher-order integrators keep
+their order and the stiff integrator's Newton solve converge; see the README's "Accuracy and stability".
+
+Parameters, packed in one float64 array: cx, cy, cz, L/2, W/2, v_max, b_thrower, omega0^2, 2 zeta omega0, w.
 """
+
+import math
 
 from numba import njit
 
-THROWER_PARAMS = 9
+THROWER_PARAMS = 10
+SMOOTH_CUTOFF = 20.0  # beyond 20 widths tanh is 1 to double precision: the weight is exactly 0 or 1
+
+
+@njit(cache=True, error_model="numpy")
+def smooth_step(d, w):
+    """The indicator of d > 0, smoothed over a width w: (1 + tanh(d / w)) / 2; the sharp step when w = 0."""
+    if w == 0.0:
+        return 1.0 if d > 0.0 else 0.0
+    z = d / w
+    if z > SMOOTH_CUTOFF:
+        return 1.0
+    if z < -SMOOTH_CUTOFF:
+        return 0.0
+    return 0.5 * (1.0 + math.tanh(z))
+
+
+@njit(cache=True, error_model="numpy")
+def box_weight(x, i, p):
+    """How much node i is inside the box, 0 to 1 (exactly 0 or 1 with sharp edges)."""
+    w = p[9]
+    if w == 0.0:
+        return 1.0 if inside_box(x, i, p) else 0.0
+    s = smooth_step(p[3] - abs(x[0, i] - p[0]), w) * smooth_step(p[4] - abs(x[1, i] - p[1]), w)
+    if x.shape[0] == 3:
+        s *= smooth_step(p[4] - abs(x[2, i] - p[2]), w)
+    return s
 
 
 @njit(cache=True, error_model="numpy")
@@ -29,9 +62,10 @@ def add_thrower(x, v, acc, inv_mass, p, g):
     w2 = p[7]
     c = p[8]
     for i in range(n):
-        if not inside_box(x, i, p):
+        s = box_weight(x, i, p)
+        if s == 0.0:
             continue
-        acc[0, i] += p[6] * inv_mass[i] * (p[5] - v[0, i])
-        acc[1, i] += g - w2 * (x[1, i] - p[1]) - c * v[1, i]
+        acc[0, i] += s * (p[6] * inv_mass[i] * (p[5] - v[0, i]))
+        acc[1, i] += s * (g - w2 * (x[1, i] - p[1]) - c * v[1, i])
         if x.shape[0] == 3:
-            acc[2, i] += -w2 * (x[2, i] - p[2]) - c * v[2, i]
+            acc[2, i] += s * (-w2 * (x[2, i] - p[2]) - c * v[2, i])
