@@ -223,3 +223,53 @@ def test_stiff_integrator_report_shows_where_it_wins():
         if r.status == "completed" and r.error_max < 0.02:
             best[r.method] = min(best.get(r.method, math.inf), r.force_evaluations)
     assert best["sdirk2"] < best["verlet"]
+
+
+# ------------------------------------------------------------------ the shooter: what limits the order
+
+
+def shooter(*sets: str):
+    width = ["thrower.edge_width=0.2", "guides.0.edge_width=0.2", "guides.1.edge_width=0.2"]
+    return ropesim.load_scene(SCENARIOS / "shooter_medium.toml", ["integrator.t_end=0.3", *width, *sets])
+
+
+def test_smoothed_edges_restore_the_order_of_rk4_and_sdirk2_on_the_shooter():
+    """With the box's and guides' edges smoothed (edge_width = 0.2 m) the forces are smooth in x and RK4 is
+    fourth order again, SDIRK2 second order (its Newton solve converges); with sharp edges neither converges
+    (scripts/shooter_order.py: errors of metres at every dt)."""
+    scene = shooter()
+    ref = run_once(scene, "rk4", 0.001 / 16).x
+    dts = [0.004, 0.002, 0.001]
+    for method, expected in (("rk4", 4.0), ("sdirk2", 2.0)):
+        errs = [np.max(np.linalg.norm(run_once(scene, method, dt).x - ref, axis=0)) for dt in dts]
+        order, _ = observed_order(dts, errs, [True] * 3)
+        assert abs(order - expected) < 0.25, (method, errs)
+
+
+def test_velocity_dependent_forces_cap_the_splitting_schemes_at_first_order():
+    """Smoothed, the shooter still leaves Verlet and PEFRL at first order: the drive b_thrower (v_max - v_x) and
+    the contact damping depend on v, and a kick evaluates them at the velocity it starts from (an explicit Euler
+    step of v' = a(x, v)). Switch those forces off and the orders 2 and 4 come back."""
+    dts = [0.002, 0.001, 0.0005]
+    still = ["thrower.b_thrower=0", "thrower.damping_ratio=0", "guides.0.damping_ratio=0",
+             "guides.1.damping_ratio=0"]
+    for sets, expected in (((), {"verlet": 1.0, "pefrl": 1.0}), (still, {"verlet": 2.0, "pefrl": 4.0})):
+        scene = shooter(*sets)
+        ref = run_once(scene, "rk4", 0.0005 / 16).x
+        for method, order_expected in expected.items():
+            errs = [np.max(np.linalg.norm(run_once(scene, method, dt).x - ref, axis=0)) for dt in dts]
+            order, _ = observed_order(dts, errs, [True] * 3)
+            assert abs(order - order_expected) < 0.25, (method, sets, errs)
+
+
+def test_smooth_step_and_box_weight():
+    from ropesim.forces.thrower import box_weight, smooth_step
+
+    assert smooth_step(0.0, 0.1) == 0.5 and smooth_step(1e-9, 0.0) == 1.0 and smooth_step(0.0, 0.0) == 0.0
+    assert smooth_step(2.0, 0.1) == 1.0 and smooth_step(-2.0, 0.1) == 0.0  # exactly, beyond 20 widths
+    p = build(shooter("thrower.edge_width=0.05")).forces[5]
+    xs = np.linspace(0.0, 8.0, 80001)  # from the box's centre across its right edge at x = 4, in 0.1 mm steps
+    w = np.array([box_weight(np.array([[x], [0.0]]), 0, p) for x in xs])
+    assert w[0] == 1.0 and w[-1] == 0.0 and np.all(np.diff(w) <= 0)
+    assert np.max(np.abs(np.diff(w))) < 1.1e-3  # no jump: the steepest slope is 1 / (2 w) = 10 per metre
+    assert np.interp(4.0, xs, w) == pytest.approx(0.5, abs=1e-6)

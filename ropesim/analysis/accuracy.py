@@ -107,7 +107,7 @@ def run_once(scene: Scene, method: str, dt: float, repeats: int = 1) -> RunResul
     ledger = stepper.ledger
     finite = bool(np.all(np.isfinite(stepper.x)) and np.all(np.isfinite(stepper.v)))
     energy_error = math.nan
-    if finite:
+    if finite and status == OK:
         energy = float(energy_terms(model, stepper.x.T, stepper.v.T)["total"])
         energy_error = energy - ledger[E0] - (ledger[HELD] + ledger[BOX] - ledger[DRAG])
     return RunResult(stepper.x.copy(), stepper.v.copy(), "completed" if status == OK else STATUS_NAMES[status],
