@@ -8,9 +8,8 @@ from Numba's cache.
 import numpy as np
 from numba import njit
 
-from .forces.gravity import add_gravity
 from .forces.guides import add_guides
-from .forces.springs import add_pair_springs
+from .forces.springs import add_pair_springs, set_chain_springs
 from .forces.thrower import add_thrower
 
 # Positions in the ``flags`` array (uint8), one per optional force term.
@@ -25,15 +24,11 @@ def accelerations(x, v, acc, forces):
     ``forces`` = (inv_mass, flags, spring, bending, gravity, thrower, guides): see :mod:`ropesim.build`.
     """
     inv_mass, flags, spring, bending, gravity, thrower, guides = forces
-    acc[:] = 0.0
     closed = spring[2] != 0.0
-    add_pair_springs(x, acc, inv_mass, spring[0], spring[1], 1, closed)
+    g = gravity[0] if flags[GRAVITY] else 0.0
+    set_chain_springs(x, acc, inv_mass, spring[0], spring[1], closed, g)  # overwrites acc; gravity included
     if flags[BENDING]:
         add_pair_springs(x, acc, inv_mass, bending[0], bending[1], 2, closed)
-    g = 0.0
-    if flags[GRAVITY]:
-        g = gravity[0]
-        add_gravity(acc, g)
     if flags[THROWER]:
         add_thrower(x, v, acc, inv_mass, thrower, g)
     if flags[GUIDES]:

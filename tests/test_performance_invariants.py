@@ -18,6 +18,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import ropesim
 from ropesim import numba_cache
@@ -137,3 +139,43 @@ def test_a_run_folder_does_not_hold_its_frames_in_memory(scenarios, tmp_path, mo
     few, many = _traced_peak(run(40)), _traced_peak(run(320))
     assert 2 * (320 - 40) * frame > 17e6
     assert many - few < 1e6, (few, many)
+
+
+@settings(max_examples=60, deadline=None)
+@given(dim=st.sampled_from([2, 3]), n=st.integers(1, 40), closed=st.booleans(), seed=st.integers(0, 2 ** 31))
+def test_vectorised_chain_springs_equal_the_pairwise_springs(dim, n, closed, seed):
+    """set_chain_springs (two vectorised passes, gravity included) = add_pair_springs(stride 1) + gravity."""
+    from ropesim.forces.springs import add_pair_springs, set_chain_springs
+
+    rng = np.random.default_rng(seed)
+    x = rng.normal(size=(dim, n))
+    if n > 2:
+        x[:, 2] = x[:, 1]   # coincident nodes: that spring has no direction and pushes nothing
+    inv_mass = rng.uniform(0.1, 3.0, size=n)
+    expected = np.zeros((dim, n))
+    add_pair_springs(x, expected, inv_mass, 40.0, 0.3, 1, closed)
+    expected[1] -= 9.81
+    got = np.full((dim, n), np.nan)   # overwritten, not added to
+    set_chain_springs(x, got, inv_mass, 40.0, 0.3, closed, 9.81)
+    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-10)
+
+
+@settings(max_examples=40, deadline=None)
+@given(n=st.integers(1, 30), seed=st.integers(0, 2 ** 31))
+def test_kick_bookkeeping_matches_the_plain_sums(n, seed):
+    """The four-lane sums of kick.py are the energy the kick books, to rounding; the kick itself is exact."""
+    from ropesim.kick import box_work, drag_kick, drag_loss
+
+    rng = np.random.default_rng(seed)
+    v, acc, acc_box = (rng.normal(size=(2, n)) for _ in range(3))
+    decay, gain, travel = (rng.uniform(0.1, 1.0, size=(2, n)) for _ in range(3))
+    mass = rng.uniform(0.5, 2.0, size=n)
+    vn = decay[1] * v + gain[1] * acc
+    way = gain[1] * v + travel[1] * acc
+    loss = np.sum(mass * (acc * way - 0.5 * (vn * vn - v * v)))
+    scale = np.sum(mass * (np.abs(acc * way) + v * v + vn * vn))
+    assert abs(drag_loss(v, acc, decay, gain, travel, 1, mass) - loss) <= 1e-13 * scale
+    assert abs(box_work(v, acc, acc_box, gain, travel, 1, mass) - np.sum(mass * acc_box * way)) <= 1e-13 * np.sum(
+        mass * np.abs(acc_box * way))
+    drag_kick(v, acc, decay, gain, 1)
+    np.testing.assert_array_equal(v, vn)

@@ -34,6 +34,71 @@ def add_pair_springs(x, acc, inv_mass, k, rest, stride, closed):
             acc[d, j] -= fd * mj
 
 
+@njit(cache=True, error_model="numpy")
+def _spring_scale(k, rest, r2):
+    """k (1 - l0 / r) for a spring of squared length r2: times the separation, its force [N]; 0 if r = 0."""
+    return k * (1.0 - rest / np.sqrt(r2)) if r2 > 0.0 else 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def set_chain_springs(x, acc, inv_mass, k, rest, closed, g):
+    """Overwrite ``acc`` with the accelerations [m/s^2] of the rope's springs (i, i + 1), minus ``g`` along y.
+
+    The same forces as ``add_pair_springs(..., stride=1, ...)`` plus gravity, computed so that both loops
+    vectorise: first each spring's force F_i (on node i, from spring (i, i + 1)) is written into ``acc[:, i]``,
+    then, from the last node down, a_i = (F_i - F_(i-1)) / m_i - g. 2-D and 3-D are written out row by row.
+    """
+    dim, n = x.shape
+    if dim == 2:
+        for i in range(n - 1):
+            d0 = x[0, i + 1] - x[0, i]
+            d1 = x[1, i + 1] - x[1, i]
+            c = _spring_scale(k, rest, d0 * d0 + d1 * d1)
+            acc[0, i] = c * d0
+            acc[1, i] = c * d1
+        l0 = l1 = 0.0   # the force of the spring closing a loop, (n - 1, 0), on node n - 1
+        if closed:
+            d0 = x[0, 0] - x[0, n - 1]
+            d1 = x[1, 0] - x[1, n - 1]
+            c = _spring_scale(k, rest, d0 * d0 + d1 * d1)
+            l0, l1 = c * d0, c * d1
+        acc[0, n - 1] = l0
+        acc[1, n - 1] = l1
+        for i in range(n - 1, 0, -1):
+            m = inv_mass[i]
+            acc[0, i] = (acc[0, i] - acc[0, i - 1]) * m
+            acc[1, i] = (acc[1, i] - acc[1, i - 1]) * m - g
+        acc[0, 0] = (acc[0, 0] - l0) * inv_mass[0]
+        acc[1, 0] = (acc[1, 0] - l1) * inv_mass[0] - g
+    else:
+        for i in range(n - 1):
+            d0 = x[0, i + 1] - x[0, i]
+            d1 = x[1, i + 1] - x[1, i]
+            d2 = x[2, i + 1] - x[2, i]
+            c = _spring_scale(k, rest, d0 * d0 + d1 * d1 + d2 * d2)
+            acc[0, i] = c * d0
+            acc[1, i] = c * d1
+            acc[2, i] = c * d2
+        l0 = l1 = l2 = 0.0
+        if closed:
+            d0 = x[0, 0] - x[0, n - 1]
+            d1 = x[1, 0] - x[1, n - 1]
+            d2 = x[2, 0] - x[2, n - 1]
+            c = _spring_scale(k, rest, d0 * d0 + d1 * d1 + d2 * d2)
+            l0, l1, l2 = c * d0, c * d1, c * d2
+        acc[0, n - 1] = l0
+        acc[1, n - 1] = l1
+        acc[2, n - 1] = l2
+        for i in range(n - 1, 0, -1):
+            m = inv_mass[i]
+            acc[0, i] = (acc[0, i] - acc[0, i - 1]) * m
+            acc[1, i] = (acc[1, i] - acc[1, i - 1]) * m - g
+            acc[2, i] = (acc[2, i] - acc[2, i - 1]) * m
+        acc[0, 0] = (acc[0, 0] - l0) * inv_mass[0]
+        acc[1, 0] = (acc[1, 0] - l1) * inv_mass[0] - g
+        acc[2, 0] = (acc[2, 0] - l2) * inv_mass[0]
+
+
 BLOCK_BYTES = 16 * 2 ** 20   # the NumPy helpers below work on at most this many bytes of positions at a time
 
 
