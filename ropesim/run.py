@@ -299,6 +299,12 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
                       force_evaluations=stepper.force_evaluations)
 
 
+def _sharp_contacts(scene: Scene) -> bool:
+    """True when the scene has a thrower box or guide circles whose edges switch sharply."""
+    return (scene.thrower is not None and scene.thrower.edge_width == 0) or any(g.edge_width == 0
+                                                                                  for g in scene.guides)
+
+
 def _blow_up_message(model: Model, stepper: Stepper, code: int, node: int) -> tuple[float | None, str]:
     """(a time step that would be stable, one line saying when, where and how the run blew up)."""
     from .analysis.stability import predicted_dt
@@ -311,7 +317,9 @@ def _blow_up_message(model: Model, stepper: Stepper, code: int, node: int) -> tu
                      f"length",
         RUNAWAY_ENERGY: f"runaway energy (the energy balance is off by more than the initial energy scale plus "
                         f"{RUNAWAY_FLOW_FRACTION:.0%} of the energy that flowed; node {node} is the fastest)",
-        NEWTON_FAILED: f"the implicit stage's Newton solve did not converge in node {node}'s neighbourhood",
+        NEWTON_FAILED: f"the implicit stage's Newton solve did not converge in node {node}'s neighbourhood"
+                       + (" (the thrower's and guides' sharp edges switch forces on and off; smooth them with "
+                          "thrower.edge_width and guides edge_width)" if _sharp_contacts(scene) else ""),
     }[code]
     bound = predicted_dt(model, method)
     if np.isfinite(bound) and bound > 0 and grid.dt > 0.5 * bound:
