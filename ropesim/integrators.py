@@ -14,8 +14,9 @@ positions. Time advances in the drifts, so held nodes are put at x0 + V t with t
 force sees positions of one instant. Linear drag is integrated exactly within each kick: with gamma = b / m,
 the kick solves v' = a - gamma v for a time c, v <- e^(-gamma c) v + (1 - e^(-gamma c)) / gamma a. Putting
 -b v into a plain kick instead would drop every scheme to first order; done this way each keeps its order
-with drag on and drag never limits the time step. (The thrower's and guides' velocity-dependent forces stay
-in the plain kick: see the README's "Accuracy and stability" for what that does to the order.)
+with drag on and drag never limits the time step. The thrower's and guides' forces are linear in velocity too:
+with their edges smoothed (``edge_width`` > 0) the nodes they touch get the exact kick of :mod:`ropesim.contact`;
+with sharp edges they stay in the plain kick (an explicit Euler step in v: first order, as before).
 
 To add a method: give a splitting scheme's coefficients (or a Runge-Kutta method's Butcher table, see
 :mod:`ropesim.rk`), its order and a line of documentation, and list it in :data:`METHODS`; its stability
@@ -32,6 +33,7 @@ import numpy as np
 from numba import njit
 
 from .health import BOX, DRAG, HELD, NON_FINITE, OK, end_step, held_power, place_held  # noqa: F401
+from .contact import exact_contact_kicks
 from .kernel import GUIDES, THROWER, accelerations, box_accelerations
 from .kick import box_work, drag_kick, drag_loss
 
@@ -179,19 +181,23 @@ def kick_factors(scheme: SplittingScheme, h: float, drag: np.ndarray, mass: np.n
 
 @njit(cache=True, error_model="numpy")
 def advance(x, v, acc, acc_box, have_acc, ledger, step0, n_steps, total_steps, h, drift, kick, decay, gain, travel,
-            reuse_force, held, mass, forces, limits, save_every, frames, check_every):
+            reuse_force, held, mass, forces, limits, save_every, frames, check_every, contacts):
     """Advance ``n_steps`` splitting steps in place, from global step ``step0`` (time step0 * h).
 
     ``held`` = (indices, x0 (D, H), V (D, H)); ``frames`` = (t (F,), x (F, D, N), v (F, D, N), ledger (F, 3)).
     Saves a frame after every global step s (1-based) with s % save_every == 0 or s == total_steps.
-    ``have_acc[0]`` carries the first-same-as-last forces between calls. Returns (steps done, frames written,
-    status, node): see :func:`ropesim.health.check_health`.
+    ``have_acc[0]`` carries the first-same-as-last forces between calls. ``contacts`` = (exact, free (N,) bool,
+    drag rate b/m (N,), scratch (D, N), scratch (N,) int64): with ``exact`` the nodes touching the box or a
+    circle get the exact kick of :mod:`ropesim.contact`. Returns (steps done, frames written, status, node):
+    see :func:`ropesim.health.check_health`.
     """
     dim, n = x.shape
     stages = kick.shape[0]
     held_idx, held_x0, held_v = held
     flags = forces[1]
     has_box = flags[THROWER] != 0 or flags[GUIDES] != 0
+    exact, free, gamma, v_contact, contact_nodes = contacts
+    exact = exact and has_box
     frame = 0
     for s in range(n_steps):
         step = step0 + s
@@ -213,7 +219,14 @@ def advance(x, v, acc, acc_box, have_acc, ledger, step0, n_steps, total_steps, h
                 box_accelerations(x, v, acc_box, forces)
             lost = drag_loss(v, acc, decay, gain, travel, k, mass)   # from the velocities before the kick
             box = box_work(v, acc, acc_box, gain, travel, k, mass) if has_box else 0.0
+            touching = 0
+            if exact:
+                touching = exact_contact_kicks(x, v, acc, v_contact, contact_nodes, kick[k] * h, gamma, free, forces)
             drag_kick(v, acc, decay, gain, k)
+            for j in range(touching):
+                i = contact_nodes[j]
+                for d in range(dim):
+                    v[d, i] = v_contact[d, i]
             ch = kick[k] * h
             ledger[DRAG] += lost
             ledger[HELD] += ch * held_power(acc, mass, held_idx, held_v)

@@ -92,6 +92,11 @@ class Stepper:
             self.kick = np.array(self.scheme.kick)
             self.decay, self.gain, self.travel = kick_factors(self.scheme, grid.dt, model.drag, model.mass,
                                                               model.held)
+            from .analysis.stability import smooth_contacts
+
+            self.exact_contacts = smooth_contacts(model)  # exact kicks for nodes touching the box or a circle
+            self.contact_scratch = (np.ascontiguousarray(~model.held), np.where(model.held, 0.0, model.drag / model.mass),
+                                    np.zeros_like(self.x), np.zeros(model.nodes, dtype=np.int64))
         elif kind == "rk":
             self.tables = self.scheme.tables()
             stages = len(self.scheme.b)
@@ -147,7 +152,7 @@ class Stepper:
             done, written, status, node = advance(
                 self.x, self.v, self.acc, self.acc_box, self.have_acc, self.ledger, self.step, n, g.steps, g.dt,
                 self.drift, self.kick, self.decay, self.gain, self.travel, self.reuse_force, self.held, m.mass,
-                m.forces, self.limits, g.save_every, frames, CHECK_EVERY)
+                m.forces, self.limits, g.save_every, frames, CHECK_EVERY, (self.exact_contacts, *self.contact_scratch))
         elif kind == "rk":
             from .rk import advance_rk
 

@@ -14,7 +14,8 @@ omega_max, the square root of the largest eigenvalue of M^-1/2 L M^-1/2 (+ omega
 A method's largest stable step is then the h at which its one-step map of the damped oscillator
 x'' = -omega^2 x - gamma x' stops being bounded (:func:`ropesim.integrators.stable_step`), with gamma the
 explicit velocity damping the method sees: the thrower's drive b_thrower / m and centring damping 2 zeta omega0,
-the guides' 2 zeta omega0, and, for Runge-Kutta (which does not integrate drag exactly), the drag b / m.
+the guides' 2 zeta omega0 (integrated exactly, like drag, by the splitting schemes when the edges are
+smoothed), and, for Runge-Kutta (which does not integrate drag exactly), the drag b / m.
 """
 
 from __future__ import annotations
@@ -132,9 +133,19 @@ def predicted_dt(model: Model, method: str, omega: float | None = None) -> float
     omega = spectral_frequency(model) if omega is None else omega
     low, high = drag_rates(model)
     damping = explicit_damping(model)
+    if scheme.kind == "splitting" and smooth_contacts(model):
+        high, damping = high + damping, 0.0  # the contacts' damping is integrated exactly, like drag
     # Damping can widen or narrow a method's interval, and the fastest mode may sit on lightly or heavily
     # damped nodes: take the worst of the extremes.
     return min(stable_step(scheme, omega, f, d) for f in {0.0, damping} for d in {low, high})
+
+
+def smooth_contacts(model: Model) -> bool:
+    """True when the box's or a circle's edges are smoothed: the splitting schemes then kick the nodes they
+    touch exactly (:mod:`ropesim.contact`)."""
+    scene = model.scene
+    return (scene.thrower is not None and scene.thrower.edge_width > 0) or any(g.edge_width > 0
+                                                                                 for g in scene.guides)
 
 
 @dataclass(frozen=True)
