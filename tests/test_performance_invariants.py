@@ -179,3 +179,16 @@ def test_kick_bookkeeping_matches_the_plain_sums(n, seed):
         mass * np.abs(acc_box * way))
     drag_kick(v, acc, decay, gain, 1)
     np.testing.assert_array_equal(v, vn)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("script, args", [
+    ("bench_kernel.py", ["--repeats", "1", "--work", "2e4", "--sizes", "21", "--method-sizes", "21,100"]),
+    ("bench_parallel.py", ["--repeats", "1", "--sizes", "1000"]),
+])
+def test_benchmark_scripts_run(script, args):
+    """The benchmarks still run against the current kernel (tiny sizes; their figures are not checked here)."""
+    proc = subprocess.run([sys.executable, str(ROOT / "scripts" / script), *args], capture_output=True, text=True,
+                          timeout=900)
+    assert proc.returncode == 0, proc.stderr
+    assert "M/s" in proc.stdout or "speed-up" in proc.stdout
