@@ -127,7 +127,7 @@ def test_loop_of_three_breathes_at_the_closed_form_frequency(method):
     assert np.max(np.abs(side - exact)) < (3e-3 if METHODS[method].order < 2 else 3e-4)
 
 
-@pytest.mark.parametrize("method", ["verlet", "sdirk2"])
+@pytest.mark.parametrize("method", ["verlet", pytest.param("sdirk2", marks=pytest.mark.slow)])
 def test_twenty_thousand_nodes(method):
     """N = 20,000 (a 2 km rope, pinned at the top, hanging straight): it stays hanging, stretched by its own
     weight, the bound falls back to Gershgorin (no dense eigenvalues), and nothing is lost."""
