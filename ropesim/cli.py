@@ -315,7 +315,7 @@ def accuracy(
     scene_file: SceneArg,
     methods: MethodsOpt = None,
     dts: Annotated[Optional[str], typer.Option(
-        "--dts", metavar="DT,DT,...", help="Time steps [s] (default: the scene's dt times 4, 2, 1, 1/2, 1/4, 1/8).",
+        "--dts", metavar="DT,DT,...", help="Time steps in seconds (default: the scene's dt times 4, 2, 1, 1/2, 1/4, 1/8).",
         show_default=False)] = None,
     repeats: Annotated[int, typer.Option("--repeats", min=1, help="Timed runs per point (the median is kept).")] = 3,
     sets: SetOpt = None,
@@ -352,7 +352,7 @@ def stability(
         "--fractions", metavar="F,F,...", help="Time steps to probe, as fractions of 2 / omega_max (default 0.1, "
                                               "0.2, ..., 2.0).", show_default=False)] = None,
     stiffness: Annotated[Optional[str], typer.Option(
-        "--k", metavar="K,K,...", help="Also sweep the spring constant rope.stiffness [N/m].",
+        "--k", metavar="K,K,...", help="Also sweep the spring constant rope.stiffness, in N/m.",
         show_default=False)] = None,
     steps: Annotated[int, typer.Option("--steps", min=10, help="Steps a probe run must survive.")] = 4000,
     sets: SetOpt = None,
