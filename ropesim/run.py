@@ -124,6 +124,8 @@ class Stepper:
         """Force evaluations so far (for the stiff integrator, its Newton iterations)."""
         if self.scheme.kind == "implicit":
             return int(self.stats[0])
+        if self.scheme.kind == "splitting":  # velocity-dependent forces rule out reusing the last kick's forces
+            return self.step * (len(self.scheme.kick) - (1 if self.reuse_force else 0))
         return self.step * self.scheme.evaluations
 
     def frames_in(self, n: int) -> int:
