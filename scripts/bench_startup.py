@@ -69,11 +69,11 @@ def measure(ropesim: str, env: dict, work: Path, repeats: int) -> dict:
     """help, cold and warm figures for one installation, with ``env`` as the environment."""
     out = work / "run"
     run = [ropesim, "run", str(SCENE), "-o", str(out), "-q"]
-    result = {"help": repeat([ropesim, "--help"], repeats, env)}
-    wall, cpu, _ = timed(run, env)
+    result = {"help": repeat([ropesim, "--help"], repeats, env, work)}
+    wall, cpu, _ = timed(run, env, work)
     result["cold"] = (wall, cpu)
     result["cold_compile"] = compile_time(out)
-    result["warm"] = repeat(run, repeats, env)
+    result["warm"] = repeat(run, repeats, env, work)
     result["warm_compile"] = compile_time(out)
     return result
 
@@ -122,9 +122,13 @@ def installed(repeats: int, console: Console) -> dict:
         subprocess.run([sys.executable, "-m", "venv", str(tmp / "venv")], check=True)
         py = tmp / "venv" / ("Scripts" if os.name == "nt" else "bin") / "python"
         subprocess.run([str(py), "-m", "pip", "install", "-q", str(ROOT)], check=True)
-        package = Path(subprocess.run([str(py), "-c", "import ropesim, os; print(os.path.dirname(ropesim.__file__))"],
-                                      check=True, capture_output=True, text=True,
-                                      env={"PATH": os.environ.get("PATH", "")}).stdout.strip())
+        # -I and a neutral cwd: the installed package, never a source tree the current folder would shadow it with
+        where = "import ropesim, os; print(os.path.dirname(ropesim.__file__))"
+        package = Path(subprocess.run([str(py), "-I", "-c", where], check=True, capture_output=True, text=True,
+                                      cwd=tmp, env={"PATH": os.environ.get("PATH", "")}).stdout.strip())
+        if not package.is_relative_to(tmp / "venv"):
+            raise RuntimeError(f"the venv imports ropesim from {package}, not from its own site-packages: refusing "
+                               f"to make that read-only")
         home = tmp / "home"
         home.mkdir()
         base = {k: os.environ[k] for k in ("PATH", "LANG", "TMPDIR") if k in os.environ}
@@ -137,7 +141,7 @@ def installed(repeats: int, console: Console) -> dict:
             # no writable home at all: the kernels go to the temporary directory
             (tmp / "tmpdir").mkdir()
             env_nohome = dict(base, HOME=str(package / "no-home"), TMPDIR=str(tmp / "tmpdir"))
-            nohome = [timed([ropesim, "run", str(SCENE), "-o", str(tmp / "run2"), "-q"], env_nohome)[0]
+            nohome = [timed([ropesim, "run", str(SCENE), "-o", str(tmp / "run2"), "-q"], env_nohome, tmp)[0]
                       for _ in range(2)]
         result.update(in_package=in_package, cached=cached, nohome=nohome)
         return result
