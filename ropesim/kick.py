@@ -6,17 +6,20 @@ for the factors). The energy drag takes out of the rope in that kick is
 
     D = sum_i m_i sum_d [ a way - (v_new^2 - v_old^2) / 2 ],
 
-the work of the forces minus the kinetic energy gained. These sums are reductions: written as one running sum they add one term at a
-time, each waiting for the last. :func:`drag_loss` and :func:`box_work` keep four running sums instead
-(terms i, i + 1, i + 2, i + 3 of each row), combined at the end in a fixed order, which the compiler can run
-side by side; the order is written out, so the result is the same to the last bit however the code is
-compiled or inlined (no fast-math reordering). The sums must be taken before the kick, from the old
+the work of the forces minus the kinetic energy gained. These sums are reductions: written as one running
+sum they add one term at a time, each waiting for the last. :func:`drag_loss` and :func:`box_work` keep four
+running sums instead (terms i, i + 1, i + 2, i + 3 of each row), combined at the end in a fixed order; the
+order is written out, so the result is the same to the last bit however the code is compiled or inlined (no
+fast-math reordering). From SCRATCH_NODES nodes on, :func:`drag_loss` first writes each node's loss into a
+scratch array (a loop that vectorises) and sums that. The sums must be taken before the kick, from the old
 velocities; :func:`drag_kick` then moves them.
 """
 
+import numpy as np
 from numba import njit
 
 LANES = 4   # running sums per reduction
+SCRATCH_NODES = 256   # from this many nodes drag_loss sums through a scratch array (its allocation then pays)
 
 
 @njit(cache=True, error_model="numpy")
@@ -26,9 +29,38 @@ def _loss(vo, a, decay, gain, travel, m):
 
 
 @njit(cache=True, error_model="numpy")
+def _lanes(t):
+    """Sum of ``t`` as four running sums combined in a fixed order."""
+    n = t.shape[0]
+    s0 = s1 = s2 = s3 = 0.0
+    whole = n - n % LANES
+    for i in range(0, whole, LANES):
+        s0 += t[i]
+        s1 += t[i + 1]
+        s2 += t[i + 2]
+        s3 += t[i + 3]
+    for i in range(whole, n):
+        s0 += t[i]
+    return (s0 + s1) + (s2 + s3)
+
+
+@njit(cache=True, error_model="numpy")
 def drag_loss(v, acc, decay, gain, travel, k, mass):
     """Energy [J] drag takes out during kick ``k`` of velocities ``v`` under accelerations ``acc`` (D, N)."""
     dim, n = v.shape
+    if n >= SCRATCH_NODES:   # each node's loss in a vectorised pass, then the sum
+        t = np.empty(n)
+        for i in range(n):
+            t[i] = 0.0
+        for d in range(dim):
+            for i in range(n):
+                vo = v[d, i]
+                a = acc[d, i]
+                vn = decay[k, i] * vo + gain[k, i] * a
+                t[i] += a * (gain[k, i] * vo + travel[k, i] * a) - 0.5 * (vn * vn - vo * vo)
+        for i in range(n):
+            t[i] *= mass[i]
+        return _lanes(t)
     s0 = s1 = s2 = s3 = 0.0
     whole = n - n % LANES
     for d in range(dim):
