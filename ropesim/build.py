@@ -7,7 +7,6 @@ per optional force term.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -151,35 +150,3 @@ def _square_loop(n: int, l: float, top_center: np.ndarray, dim: int) -> np.ndarr
 
 def spring_count(n: int, stride: int, closed: bool) -> int:
     return n if closed else max(n - stride, 0)
-
-
-def stability_frequency(model: Model) -> float:
-    """Upper bound [rad/s] on the highest natural frequency of the linearised rope (Gershgorin).
-
-    Bounds the spectrum of M^(-1/2) K M^(-1/2), with K the stiffness of every spring (a spring of stiffness
-    k couples its ends with at most k in any direction) plus the thrower's and guides' centring springs,
-    whose omega0^2 adds to every node they can hold. For a uniform chain this is 2 sqrt(k/m), the
-    frequency of its fastest (zig-zag) mode, twice the single spring's sqrt(k/m).
-    """
-    scene = model.scene
-    n = model.nodes
-    inv_sqrt_m = 1.0 / np.sqrt(model.mass)
-    row = np.zeros(n)
-    pairs = [(1, scene.rope.stiffness)]
-    if scene.bending is not None:
-        pairs.append((2, scene.bending.stiffness))
-    for stride, k in pairs:
-        i = np.arange(spring_count(n, stride, scene.rope.closed))
-        j = (i + stride) % n
-        # row sums of |M^-1/2 K M^-1/2|: diagonal k/m_i plus off-diagonal k/sqrt(m_i m_j), for each end
-        coupling = k * inv_sqrt_m[i] * inv_sqrt_m[j]
-        np.add.at(row, i, k / model.mass[i] + coupling)
-        np.add.at(row, j, k / model.mass[j] + coupling)
-    extra = 0.0
-    if scene.thrower is not None:
-        extra = scene.thrower.omega0 * scene.thrower.omega0  # inf, not OverflowError, if absurdly large
-    for guide in scene.guides:
-        extra = max(extra, guide.omega0 * guide.omega0)
-    row[~model.held] += extra
-    free = ~model.held
-    return float(math.sqrt(row[free].max())) if free.any() else 0.0

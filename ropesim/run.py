@@ -365,7 +365,6 @@ def simulate(scene: Scene, folder: str | Path | None = None, progress: bool = Fa
             outcome = integrate(model, store, on_progress)
         arrays = store.arrays()
         summary = summarize(model, outcome, arrays["t"], arrays["x"], arrays["v"])
-        summary.update(_ledger_summary(model, outcome, arrays))
         if folder is not None:
             write_ledger(folder, arrays["t"], outcome.ledger, outcome.energy0)
             store.finish()
@@ -374,21 +373,6 @@ def simulate(scene: Scene, folder: str | Path | None = None, progress: bool = Fa
         return Trajectory(t=arrays["t"], x=arrays["x"], v=arrays["v"], scene=scene, summary=summary)
     finally:
         store.discard()
-
-
-def _ledger_summary(model: Model, outcome: RunOutcome, arrays: dict) -> dict:
-    """Summary entries of this module's: the stability bound of the run's method (None when it has none), the
-    force evaluations, and the energy ledger's balance (when the last frame is finite)."""
-    from .analysis.ledger import ledger_series, ledger_summary
-    from .analysis.stability import predicted_dt
-
-    bound = predicted_dt(model, model.scene.integrator.method)
-    out = {"stable_dt_bound": bound if np.isfinite(bound) else None, "force_evaluations": outcome.force_evaluations}
-    x, v = arrays["x"], arrays["v"]
-    if np.all(np.isfinite(x[-1])) and np.all(np.isfinite(v[-1])):
-        out["energy_ledger"] = ledger_summary(ledger_series(model, x, v, outcome.ledger, outcome.energy0),
-                                              outcome.energy0)
-    return out
 
 
 @contextmanager

@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 
 from .. import __version__
-from ..build import Model, stability_frequency
+from ..build import Model
 from ..forces.springs import pair_spring_stretch
-from ..integrators import get_method
 from .energy import energy_terms
+from .ledger import ledger_series, ledger_summary
+from .stability import predicted_dt
 from .towed import towed_end, towed_figures
 
 FRAME_BLOCK = 256  # frames per block when scanning a (possibly memory-mapped) trajectory
@@ -38,8 +39,6 @@ def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray
     """Everything a user wants to know about a finished (or stopped) run, as JSON-ready values."""
     scene = model.scene
     grid = outcome.grid
-    scheme = get_method(scene.integrator.method)
-    omega = stability_frequency(model)
     node_steps = outcome.steps * model.nodes
     summary: dict = {
         "scene": scene.name,
@@ -56,7 +55,8 @@ def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray
         "compile_time_s": round(outcome.compile_time, 6),
         "steps_per_second": round(outcome.steps / outcome.wall_time, 1) if outcome.wall_time > 0 else None,
         "node_steps_per_second": round(node_steps / outcome.wall_time, 1) if outcome.wall_time > 0 else None,
-        "stable_dt_bound": scheme.stability_limit / omega if omega > 0 else None,
+        "stable_dt_bound": _finite_or_none(predicted_dt(model, scene.integrator.method)),
+        "force_evaluations": outcome.force_evaluations,
     }
     if outcome.message:
         summary["message"] = outcome.message
@@ -66,7 +66,14 @@ def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray
     if finite:
         with np.errstate(over="ignore", invalid="ignore"):  # a run stopped by a blow-up may end huge
             summary.update(_physics_figures(model, t, x, v))
+            summary["energy_ledger"] = ledger_summary(ledger_series(model, x, v, outcome.ledger, outcome.energy0),
+                                                      outcome.energy0)
     return summary
+
+
+def _finite_or_none(value: float) -> float | None:
+    """JSON has no infinity: an unconditionally stable method has no bound (None)."""
+    return float(value) if np.isfinite(value) else None
 
 
 def _physics_figures(model: Model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> dict:
