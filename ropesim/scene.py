@@ -226,7 +226,8 @@ class Integrator:
 
 @dataclass(frozen=True)
 class Output:
-    """Which frames are saved: every ``interval`` seconds (rounded to a whole number of steps)."""
+    """Which frames are saved: every ``interval`` seconds, rounded to a whole number of steps (at least one),
+    and always the last step."""
 
     interval: float = spec("float", "time between saved frames", "s", default=0.01, low=0, open_low=True)
 
