@@ -6,11 +6,10 @@ line. Runs that did not complete, or lack the figure, leave a gap. Drawn from th
 
 from __future__ import annotations
 
-import os
 import re
-import tempfile
 from pathlib import Path
 
+from .atomic import atomic_output
 from .sweep import Axis, SweepError, _is_number, _label, _numeric_axis, toml_value
 
 
@@ -47,14 +46,11 @@ def plot_figure(rows: list[dict], axes: list[Axis], figure: str, folder: Path, t
     if others:
         ax.legend(fontsize=8)
     path = folder / re.sub(r"[^A-Za-z0-9._=+-]", "-", f"{figure}_vs_{x_axis.key}.png")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    os.close(fd)
     try:
-        fig.savefig(tmp, format="png", dpi=120)
-        os.replace(tmp, path)
+        with atomic_output(path) as tmp:
+            fig.savefig(tmp, format="png", dpi=120)
     finally:
         plt.close(fig)
-        Path(tmp).unlink(missing_ok=True)
     return path
 
 

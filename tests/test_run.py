@@ -117,6 +117,10 @@ def test_run_folder_is_plain_npz_and_reads_lazily(scenarios, tmp_path):
     scene = ropesim.load_scene(scenarios / "shooter_low.toml", ["integrator.t_end=0.2"])
     traj = ropesim.simulate(scene, tmp_path)
     assert sorted(os.listdir(tmp_path)) == ["ledger.npz", "scene.toml", "summary.json", "trajectory.npz"]
+    mask = os.umask(0)
+    os.umask(mask)
+    for name in os.listdir(tmp_path):  # readable like any new file, not mkstemp's private 0600
+        assert (tmp_path / name).stat().st_mode & 0o777 == 0o666 & ~mask
     with zipfile.ZipFile(tmp_path / "trajectory.npz") as zf:
         assert all(i.compress_type == zipfile.ZIP_STORED for i in zf.infolist())
     with np.load(tmp_path / "trajectory.npz") as npz:

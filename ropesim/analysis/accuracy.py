@@ -193,7 +193,7 @@ def plot(report: Report, path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..render.output import atomic_output
+    from ..atomic import atomic_output
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), constrained_layout=True)
     for name in dict.fromkeys(r.method for r in report.rows):

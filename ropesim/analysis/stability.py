@@ -321,7 +321,7 @@ def plot_sweep(result: SweepResult, path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..render.output import atomic_output
+    from ..atomic import atomic_output
 
     methods = list(dict.fromkeys(r["method"] for r in result.rows))
     ks = sorted({r["stiffness"] for r in result.rows})

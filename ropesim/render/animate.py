@@ -19,7 +19,8 @@ from ..trajectory import Trajectory
 from . import RenderError
 from .encode import ANIMATION_TYPES, GIF_MAX_FPS, gif_fps, write_gif, write_mp4
 from .framing import Projection, figure_inches, followed_nodes, origin, projection, single_view, view_box
-from .output import atomic_output, output_type
+from ..atomic import atomic_output
+from .output import output_type
 from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
 from .timeline import animation_plan
 

@@ -17,7 +17,8 @@ from . import RenderError
 from ..build import build
 from ..trajectory import Trajectory
 from .framing import figure_inches, fit_box, followed_nodes, origin, projection, view_aspect, view_box
-from .output import atomic_output, output_type
+from ..atomic import atomic_output
+from .output import output_type
 from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
 from .timeline import chosen_frames
 

@@ -20,7 +20,8 @@ from ..build import Model, build
 from ..forces.springs import pair_spring_stretch
 from ..trajectory import Trajectory
 from .framing import figure_inches, frame_blocks
-from .output import atomic_output, output_type
+from ..atomic import atomic_output
+from .output import output_type
 
 DPI = 100
 WIDTH = 720          # [px]
