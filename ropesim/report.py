@@ -51,10 +51,13 @@ def print_summary(summary: dict, folder: Path) -> None:
                                          f"{shooter['averaged_over_s']:.3g} s)"))
     ledger = summary.get("energy_ledger")
     if ledger:
-        rows.append(("energy ledger", f"drag took {ledger['drag_loss_J']:.4g} J, held nodes gave "
-                                      f"{ledger['held_work_J']:.4g} J, thrower and guides gave {ledger['box_work_J']:.4g} "
-                                      f"J; balance off by at most {ledger['max_residual_J']:.3g} J "
-                                      f"({ledger['relative_residual']:.2g} of the energy that "
+        flows = [f"{what} {ledger[key]:.4g} J" for what, key in (("drag took", "drag_loss_J"),
+                                                                  ("held nodes gave", "held_work_J"),
+                                                                  ("thrower and guides gave", "box_work_J"))
+                 if ledger[key] != 0.0]
+        rows.append(("energy ledger", f"{', '.join(flows) or 'no energy flowed in or out'}; balance off by at "
+                                      f"most {ledger['max_residual_J']:.3g} J ({ledger['relative_residual']:.2g} "
+                                      f"of the energy that "
                                       f"{'flowed' if ledger['relative_to'] == 'flows' else 'moved'})"))
     if summary.get("message"):
         rows.append(("stopped", summary["message"]))
