@@ -34,8 +34,11 @@ from numba import njit
 
 from .health import BOX, DRAG, HELD, NON_FINITE, OK, end_step, held_power, place_held  # noqa: F401
 from .contact import exact_contact_kicks
-from .kernel import GUIDES, THROWER, accelerations, box_accelerations
-from .kick import box_work, drag_kick, drag_loss
+from .forces.guides import add_guides
+from .forces.springs import add_pair_springs, set_chain_springs
+from .forces.thrower import add_thrower
+from .kernel import BENDING, GRAVITY, GUIDES, THROWER, box_accelerations
+from .kick import box_work, kick_drift
 
 
 @dataclass(frozen=True)
@@ -194,48 +197,76 @@ def advance(x, v, acc, acc_box, have_acc, ledger, step0, n_steps, total_steps, h
     dim, n = x.shape
     stages = kick.shape[0]
     held_idx, held_x0, held_v = held
-    flags = forces[1]
-    has_box = flags[THROWER] != 0 or flags[GUIDES] != 0
+    inv_mass, flags, spring, bending, gravity, thrower, guides = forces
+    closed = spring[2] != 0.0
+    g = gravity[0] if flags[GRAVITY] else 0.0
+    stiffness, rest = spring[0], spring[1]
+    has_bending = flags[BENDING] != 0
+    has_thrower = flags[THROWER] != 0
+    has_guides = flags[GUIDES] != 0
+    has_box = has_thrower or has_guides
     exact, free, gamma, v_contact, contact_nodes = contacts
     exact = exact and has_box
+    n_held = held_idx.shape[0]
+    buf = np.empty(n)   # kick_drift's per-node losses
     frame = 0
     for s in range(n_steps):
         step = step0 + s
         t = step * h
-        for k in range(stages + 1):
-            c = drift[k]
-            if c != 0.0:
-                ch = c * h
-                for d in range(dim):
-                    for i in range(n):
-                        x[d, i] += ch * v[d, i]
-                t += ch
-                place_held(x, held_idx, held_x0, held_v, t)
-            if k == stages:
-                break
-            if not (k == 0 and reuse_force and have_acc[0]):
-                accelerations(x, v, acc, forces)
+        if drift[0] != 0.0:
+            ch = drift[0] * h
+            for d in range(dim):
+                for i in range(n):
+                    x[d, i] += ch * v[d, i]
+            t += ch
+            place_held(x, held_idx, held_x0, held_v, t)
+        for k in range(stages):
+            if not (k == 0 and reuse_force and have_acc[0]):   # accelerations(), its force tuple unpacked once
+                set_chain_springs(x, acc, inv_mass, stiffness, rest, closed, g)
+                if has_bending:
+                    add_pair_springs(x, acc, inv_mass, bending[0], bending[1], 2, closed)
+                if has_thrower:
+                    add_thrower(x, v, acc, inv_mass, thrower, g)
+                if has_guides:
+                    add_guides(x, v, acc, guides, thrower, has_thrower, g)
+            box = 0.0
             if has_box:
                 box_accelerations(x, v, acc_box, forces)
-            lost = drag_loss(v, acc, decay, gain, travel, k, mass)   # from the velocities before the kick
-            box = box_work(v, acc, acc_box, gain, travel, k, mass) if has_box else 0.0
+                box = box_work(v, acc, acc_box, gain, travel, k, mass)   # from the velocities before the kick
             touching = 0
             if exact:
                 touching = exact_contact_kicks(x, v, acc, v_contact, contact_nodes, kick[k] * h, gamma, free, forces)
-            drag_kick(v, acc, decay, gain, k)
+            drifting = drift[k + 1] != 0.0
+            ch = drift[k + 1] * h
+            # the kick, the loss it books (from the velocities before it) and the next drift, fused; a contact
+            # kick replaces some velocities first, so then the drift runs on its own
+            lost = kick_drift(x, v, acc, decay, gain, travel, k, mass, ch if drifting and touching == 0 else 0.0,
+                              buf)
             for j in range(touching):
                 i = contact_nodes[j]
                 for d in range(dim):
                     v[d, i] = v_contact[d, i]
-            ch = kick[k] * h
+            if drifting and touching != 0:
+                for d in range(dim):
+                    for i in range(n):
+                        x[d, i] += ch * v[d, i]
+            ck = kick[k] * h
             ledger[DRAG] += lost
-            ledger[HELD] += ch * held_power(acc, mass, held_idx, held_v)
+            p = 0.0   # held_power(): the supports' power on the rope
+            for j in range(n_held):
+                i = held_idx[j]
+                for d in range(dim):
+                    p -= mass[i] * acc[d, i] * held_v[d, j]
+            ledger[HELD] += ck * p
             if has_box:
-                for j in range(held_idx.shape[0]):
+                for j in range(n_held):
                     i = held_idx[j]
                     for d in range(dim):
-                        box += ch * mass[i] * acc_box[d, i] * held_v[d, j]
+                        box += ck * mass[i] * acc_box[d, i] * held_v[d, j]
                 ledger[BOX] += box
+            if drifting:
+                t += ch
+                place_held(x, held_idx, held_x0, held_v, t)
         have_acc[0] = reuse_force
         done = step + 1
         if done % check_every and done % save_every and done != total_steps:

@@ -103,3 +103,65 @@ def drag_kick(v, acc, decay, gain, k):
     for d in range(dim):
         for i in range(n):
             v[d, i] = decay[k, i] * v[d, i] + gain[k, i] * acc[d, i]
+
+
+@njit(cache=True, error_model="numpy")
+def kick_drift(x, v, acc, decay, gain, travel, k, mass, c, buf):
+    """Kick ``k`` and then, when ``c`` != 0, the drift x <- x + c v, in as few passes as the ledger allows.
+
+    Returns the energy [J] drag takes out during the kick: the same number, to the last bit, as
+    :func:`drag_loss` before :func:`drag_kick` (the same terms summed in the same order), and the same new
+    velocities and positions as :func:`drag_kick` followed by a separate drift. ``buf`` is (N,) scratch.
+    Each row is one pass (it vectorises) that kicks, drifts and writes each term of the loss into ``buf``;
+    only the running sums that follow are sequential.
+    """
+    dim, n = v.shape
+    # the four versions of a row's pass are written out: a flag tested inside the loop stops it vectorising
+    if n >= SCRATCH_NODES:   # buf sums each node's loss over the rows
+        for i in range(n):
+            buf[i] = 0.0
+        for d in range(dim):
+            if c != 0.0:
+                for i in range(n):
+                    vo = v[d, i]
+                    a = acc[d, i]
+                    vn = decay[k, i] * vo + gain[k, i] * a
+                    buf[i] += a * (gain[k, i] * vo + travel[k, i] * a) - 0.5 * (vn * vn - vo * vo)
+                    v[d, i] = vn
+                    x[d, i] += c * vn
+            else:
+                for i in range(n):
+                    vo = v[d, i]
+                    a = acc[d, i]
+                    vn = decay[k, i] * vo + gain[k, i] * a
+                    buf[i] += a * (gain[k, i] * vo + travel[k, i] * a) - 0.5 * (vn * vn - vo * vo)
+                    v[d, i] = vn
+        for i in range(n):
+            buf[i] *= mass[i]
+        return _lanes(buf)
+    s0 = s1 = s2 = s3 = 0.0
+    whole = n - n % LANES
+    for d in range(dim):   # buf holds one row's terms
+        if c != 0.0:
+            for i in range(n):
+                vo = v[d, i]
+                a = acc[d, i]
+                vn = decay[k, i] * vo + gain[k, i] * a
+                buf[i] = mass[i] * (a * (gain[k, i] * vo + travel[k, i] * a) - 0.5 * (vn * vn - vo * vo))
+                v[d, i] = vn
+                x[d, i] += c * vn
+        else:
+            for i in range(n):
+                vo = v[d, i]
+                a = acc[d, i]
+                vn = decay[k, i] * vo + gain[k, i] * a
+                buf[i] = mass[i] * (a * (gain[k, i] * vo + travel[k, i] * a) - 0.5 * (vn * vn - vo * vo))
+                v[d, i] = vn
+        for i in range(0, whole, LANES):
+            s0 += buf[i]
+            s1 += buf[i + 1]
+            s2 += buf[i + 2]
+            s3 += buf[i + 3]
+        for i in range(whole, n):
+            s0 += buf[i]
+    return (s0 + s1) + (s2 + s3)
