@@ -7,25 +7,17 @@ for the factors). The energy drag takes out of the rope in that kick is
     D = sum_i m_i sum_d [ a way - (v_new^2 - v_old^2) / 2 ],
 
 the work of the forces minus the kinetic energy gained. These sums are reductions: written as one running
-sum they add one term at a time, each waiting for the last. :func:`drag_loss` and :func:`box_work` keep four
-running sums instead (terms i, i + 1, i + 2, i + 3 of each row), combined at the end in a fixed order; the
-order is written out, so the result is the same to the last bit however the code is compiled or inlined (no
-fast-math reordering). From SCRATCH_NODES nodes on, :func:`drag_loss` first writes each node's loss into a
-scratch array (a loop that vectorises) and sums that. The sums must be taken before the kick, from the old
-velocities; :func:`drag_kick` then moves them.
+sum they add one term at a time, each waiting for the last. :func:`kick_drift` and :func:`box_work` keep four
+running sums instead (terms i, i + 1, i + 2, i + 3), combined at the end in a fixed order; the order is written
+out, so the result is the same to the last bit however the code is compiled or inlined (no fast-math
+reordering). The loss terms are computed in the same vectorised pass that kicks (and drifts) each row, into a
+scratch row, before the sums.
 """
 
-import numpy as np
 from numba import njit
 
 LANES = 4   # running sums per reduction
-SCRATCH_NODES = 256   # from this many nodes drag_loss sums through a scratch array (its allocation then pays)
-
-
-@njit(cache=True, error_model="numpy")
-def _loss(vo, a, decay, gain, travel, m):
-    vn = decay * vo + gain * a
-    return m * (a * (gain * vo + travel * a) - 0.5 * (vn * vn - vo * vo))
+SCRATCH_NODES = 256   # from this many nodes kick_drift sums each node's loss over the rows before the lanes
 
 
 @njit(cache=True, error_model="numpy")
@@ -41,36 +33,6 @@ def _lanes(t):
         s3 += t[i + 3]
     for i in range(whole, n):
         s0 += t[i]
-    return (s0 + s1) + (s2 + s3)
-
-
-@njit(cache=True, error_model="numpy")
-def drag_loss(v, acc, decay, gain, travel, k, mass):
-    """Energy [J] drag takes out during kick ``k`` of velocities ``v`` under accelerations ``acc`` (D, N)."""
-    dim, n = v.shape
-    if n >= SCRATCH_NODES:   # each node's loss in a vectorised pass, then the sum
-        t = np.empty(n)
-        for i in range(n):
-            t[i] = 0.0
-        for d in range(dim):
-            for i in range(n):
-                vo = v[d, i]
-                a = acc[d, i]
-                vn = decay[k, i] * vo + gain[k, i] * a
-                t[i] += a * (gain[k, i] * vo + travel[k, i] * a) - 0.5 * (vn * vn - vo * vo)
-        for i in range(n):
-            t[i] *= mass[i]
-        return _lanes(t)
-    s0 = s1 = s2 = s3 = 0.0
-    whole = n - n % LANES
-    for d in range(dim):
-        for i in range(0, whole, LANES):
-            s0 += _loss(v[d, i], acc[d, i], decay[k, i], gain[k, i], travel[k, i], mass[i])
-            s1 += _loss(v[d, i + 1], acc[d, i + 1], decay[k, i + 1], gain[k, i + 1], travel[k, i + 1], mass[i + 1])
-            s2 += _loss(v[d, i + 2], acc[d, i + 2], decay[k, i + 2], gain[k, i + 2], travel[k, i + 2], mass[i + 2])
-            s3 += _loss(v[d, i + 3], acc[d, i + 3], decay[k, i + 3], gain[k, i + 3], travel[k, i + 3], mass[i + 3])
-        for i in range(whole, n):
-            s0 += _loss(v[d, i], acc[d, i], decay[k, i], gain[k, i], travel[k, i], mass[i])
     return (s0 + s1) + (s2 + s3)
 
 
@@ -97,21 +59,11 @@ def box_work(v, acc, acc_box, gain, travel, k, mass):
 
 
 @njit(cache=True, error_model="numpy")
-def drag_kick(v, acc, decay, gain, k):
-    """Kick ``k``: v <- decay v + gain a for every node and coordinate (drag integrated exactly)."""
-    dim, n = v.shape
-    for d in range(dim):
-        for i in range(n):
-            v[d, i] = decay[k, i] * v[d, i] + gain[k, i] * acc[d, i]
-
-
-@njit(cache=True, error_model="numpy")
 def kick_drift(x, v, acc, decay, gain, travel, k, mass, c, buf):
     """Kick ``k`` and then, when ``c`` != 0, the drift x <- x + c v, in as few passes as the ledger allows.
 
-    Returns the energy [J] drag takes out during the kick: the same number, to the last bit, as
-    :func:`drag_loss` before :func:`drag_kick` (the same terms summed in the same order), and the same new
-    velocities and positions as :func:`drag_kick` followed by a separate drift. ``buf`` is (N,) scratch.
+    Returns the energy [J] drag takes out during the kick (see the module docstring). The new velocities are
+    v <- decay v + gain a (drag integrated exactly) and the drift uses them. ``buf`` is (N,) scratch.
     Each row is one pass (it vectorises) that kicks, drifts and writes each term of the loss into ``buf``;
     only the running sums that follow are sequential.
     """

@@ -161,24 +161,31 @@ def test_vectorised_chain_springs_equal_the_pairwise_springs(dim, n, closed, see
 
 
 @settings(max_examples=40, deadline=None)
-@given(n=st.one_of(st.integers(1, 30), st.integers(250, 300)), seed=st.integers(0, 2 ** 31))
-def test_kick_bookkeeping_matches_the_plain_sums(n, seed):
-    """The four-lane sums of kick.py are the energy the kick books, to rounding; the kick itself is exact."""
-    from ropesim.kick import box_work, drag_kick, drag_loss
+@given(n=st.one_of(st.integers(1, 30), st.integers(250, 300)), seed=st.integers(0, 2 ** 31),
+       c=st.sampled_from([0.0, 1e-3]))
+def test_kick_bookkeeping_matches_the_plain_sums(n, seed, c):
+    """The four-lane sums of kick.py are the energy the kick books, to rounding; the kick and drift are exact.
+
+    Both of kick_drift's paths (below and from SCRATCH_NODES nodes) and both of its row passes (with a drift,
+    c != 0, and without) are exercised.
+    """
+    from ropesim.kick import box_work, kick_drift
 
     rng = np.random.default_rng(seed)
-    v, acc, acc_box = (rng.normal(size=(2, n)) for _ in range(3))
+    x, v, acc, acc_box = (rng.normal(size=(2, n)) for _ in range(4))
     decay, gain, travel = (rng.uniform(0.1, 1.0, size=(2, n)) for _ in range(3))
     mass = rng.uniform(0.5, 2.0, size=n)
     vn = decay[1] * v + gain[1] * acc
     way = gain[1] * v + travel[1] * acc
     loss = np.sum(mass * (acc * way - 0.5 * (vn * vn - v * v)))
     scale = np.sum(mass * (np.abs(acc * way) + v * v + vn * vn))
-    assert abs(drag_loss(v, acc, decay, gain, travel, 1, mass) - loss) <= 1e-13 * scale
     assert abs(box_work(v, acc, acc_box, gain, travel, 1, mass) - np.sum(mass * acc_box * way)) <= 1e-13 * np.sum(
         mass * np.abs(acc_box * way))
-    drag_kick(v, acc, decay, gain, 1)
+    xn = x + c * vn if c != 0.0 else x.copy()
+    booked = kick_drift(x, v, acc, decay, gain, travel, 1, mass, c, np.empty(n))
+    assert abs(booked - loss) <= 1e-13 * scale
     np.testing.assert_array_equal(v, vn)
+    np.testing.assert_array_equal(x, xn)
 
 
 @pytest.mark.slow
