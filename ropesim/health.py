@@ -54,12 +54,19 @@ def first_non_finite(x):
 @njit(cache=True, error_model="numpy")
 def check_health(x, v, mass, forces, ledger, limits):
     """(status, node): OK and -1 when the state is sane, else the first problem found (see the module doc)."""
-    bad = first_non_finite(x)
-    if bad < 0:
-        bad = first_non_finite(v)
-    if bad >= 0:
-        return NON_FINITE, bad
     energy, stretch, node = mechanical_energy(x, v, mass, forces)
+    return verdict(energy, stretch, node, x, v, ledger, limits)
+
+
+@njit(cache=True, error_model="numpy")
+def verdict(energy, stretch, node, x, v, ledger, limits):
+    """:func:`check_health` given the mechanical energy [J] and the worst stretch (and its node) of the state."""
+    if not np.isfinite(energy):   # every position and velocity enters the energy: look for the culprit only now
+        bad = first_non_finite(x)
+        if bad < 0:
+            bad = first_non_finite(v)
+        if bad >= 0:
+            return NON_FINITE, bad
     if stretch > limits[0]:
         return OVERSTRETCH, node
     flowed = ledger[HELD] + ledger[BOX] - ledger[DRAG]
