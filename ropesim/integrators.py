@@ -18,6 +18,10 @@ with drag on and drag never limits the time step. The thrower's and guides' forc
 with their edges smoothed (``edge_width`` > 0) the nodes they touch get the exact kick of :mod:`ropesim.contact`;
 with sharp edges they stay in the plain kick (an explicit Euler step in v: first order, as before).
 
+:func:`advance` below runs every splitting scheme on every scene. A 2-D rope with nothing but its own springs,
+gravity and drag (the towed ropes) runs instead on :func:`ropesim.chain.advance_chain`, the same steps written
+for that scene alone, with bit-identical trajectories.
+
 To add a method: give a splitting scheme's coefficients (or a Runge-Kutta method's Butcher table, see
 :mod:`ropesim.rk`), its order and a line of documentation, and list it in :data:`METHODS`; its stability
 interval is computed from the coefficients by :func:`stable_step`.

@@ -62,12 +62,16 @@ class TimeGrid:
 class Stepper:
     """The scene's state and the compiled step loop of its method; ``advance(n)`` moves it n steps forward.
 
+    A splitting scheme on a plain 2-D spring rope runs on the fast path of :mod:`ropesim.chain` (``chain`` holds
+    its arrays; None otherwise).
+
     Besides x and v it carries the energy ledger (``ledger``: drag loss, work of held nodes, work of the box
     and guides, initial energy, energy scale; see :mod:`ropesim.health`) and, for the stiff integrator, the
     Newton iterations so far (``stats``).
     """
 
-    def __init__(self, model: Model, method: str, grid: TimeGrid):
+    def __init__(self, model: Model, method: str, grid: TimeGrid, specialise: bool = True):
+        """``specialise=False`` keeps a plain spring rope off the fast path of :mod:`ropesim.chain` (for tests)."""
         from .analysis.energy import energy_terms
         from .health import E0, LEDGER_SIZE, SCALE
 
@@ -97,6 +101,10 @@ class Stepper:
             self.exact_contacts = smooth_contacts(model)  # exact kicks for nodes touching the box or a circle
             self.contact_scratch = (np.ascontiguousarray(~model.held), np.where(model.held, 0.0, model.drag / model.mass),
                                     np.zeros_like(self.x), np.zeros(model.nodes, dtype=np.int64))
+            from . import chain
+
+            self.chain = (chain.ChainState(model, self.decay, self.gain, self.travel)
+                          if specialise and chain.applies(model, self.scheme) else None)
         elif kind == "rk":
             self.tables = self.scheme.tables()
             stages = len(self.scheme.b)
@@ -150,7 +158,15 @@ class Stepper:
             frames = self.new_frames(n)
         m, g = self.model, self.grid
         kind = self.scheme.kind
-        if kind == "splitting":
+        if kind == "splitting" and self.chain is not None:
+            from .chain import advance_chain
+
+            c = self.chain
+            done, written, status, node = advance_chain(
+                self.x, self.v, c.forces, c.lost, self.ledger, self.have_acc, self.step, n, g.steps, g.dt, self.drift,
+                self.kick, c.bulk, c.exceptions, c.exception_factors, c.saved, self.reuse_force, self.held, m.mass,
+                m.forces, c.free_mass, c.kinetic0, c.has_drag, self.limits, g.save_every, frames, CHECK_EVERY)
+        elif kind == "splitting":
             done, written, status, node = advance(
                 self.x, self.v, self.acc, self.acc_box, self.have_acc, self.ledger, self.step, n, g.steps, g.dt,
                 self.drift, self.kick, self.decay, self.gain, self.travel, self.reuse_force, self.held, m.mass,

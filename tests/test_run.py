@@ -98,7 +98,7 @@ def test_ctrl_c_in_a_real_run(scenarios, tmp_path):
     """SIGINT to `ropesim run`: exit 130, one line saying where it stopped, the run folder holds the frames."""
     out = tmp_path / "run"
     proc = subprocess.Popen([sys.executable, "-m", "ropesim", "run", str(scenarios / "helicopter_uniform.toml"),
-                             "--out", str(out), "--set", "integrator.t_end=20000", "--set", "output.interval=1"],
+                             "--out", str(out), "--set", "integrator.t_end=1000000", "--set", "output.interval=50"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.time() + 60
     while time.time() < deadline and not any(out.glob(".frames-*")):
