@@ -7,8 +7,9 @@ at 8 m/s, Hookean springs, gravity, linear drag integrated exactly in the kick, 
    spring's force into a buffer, one loop kicking and drifting every free node, `error_model="numpy"`. Both
    loops vectorise. It knows nothing but this scene: no held-node list, no energy ledger, no blow-up checks.
 2. The same step written with vectorised NumPy array operations (buffers preallocated).
-3. ropesim's own compiled loop (:class:`ropesim.run.Stepper`), everything included: held nodes, the
-   energy ledger, the blow-up check every 64 steps.
+3. ropesim's own compiled loop (:class:`ropesim.run.Stepper`, here on its fast path :mod:`ropesim.chain`),
+   everything included: per-node masses and drag, held nodes, the energy ledger, the blow-up check every
+   64 steps.
 
 All three start from the same state, run the same steps and end at the same positions (checked). They run
 interleaved in one process; the table shows the median rates and the median of the per-round ratios.
