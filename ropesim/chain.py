@@ -32,8 +32,8 @@ import numpy as np
 from numba import njit
 
 from .health import DRAG, HELD, OK, save_frame, verdict
-from .kernel import BENDING, GRAVITY, GUIDES, THROWER, rope_energy
-from .kick import LANES
+from .kernel import BENDING, GRAVITY, GUIDES, THROWER
+from .kick import LANES, _lanes
 
 BULK_FIXED = 1        # bulk = [1 / m, then per kick stage: decay, gain, reach]
 BULK_PER_STAGE = 3
@@ -78,32 +78,66 @@ class ChainState:
         self.forces = np.zeros((2, model.nodes + 1))
         self.lost = np.zeros(model.nodes)
         self.free_mass = np.where(free, mass, 0.0)
-        self.kinetic0 = -settle(np.zeros(model.nodes), model.v0, self.free_mass, 0.0)   # the free nodes' K [J]
+        self.scratch = (np.zeros(model.nodes), np.zeros(model.nodes))   # spring lengths, per-node terms
+        self.kinetic0 = -settle(np.zeros(model.nodes), model.v0, self.free_mass, 0.0, self.scratch[1])   # K(0) [J]
         self.has_drag = bool(np.any(drag[free] > 0.0))
 
 
 @njit(cache=True, error_model="numpy")
-def settle(lost, v, free_mass, kinetic0):
+def settle(lost, v, free_mass, kinetic0, terms):
     """sum_i m_i (lost_i - |v_i|^2 / 2) + kinetic0 over the free nodes (m_i = 0 at held ones), in a fixed order.
 
     With ``lost`` the work per unit mass booked since the start and ``kinetic0`` the free nodes' kinetic energy
-    then, this is the energy drag has taken out [J].
+    then, this is the energy drag has taken out [J]. ``terms`` (N,) is scratch.
     """
-    n = v.shape[1]
-    s0 = s1 = s2 = s3 = 0.0
-    whole = n - n % LANES
-    for i in range(0, whole, LANES):
-        s0 += free_mass[i] * (lost[i] - 0.5 * (v[0, i] * v[0, i] + v[1, i] * v[1, i]))
-        s1 += free_mass[i + 1] * (lost[i + 1] - 0.5 * (v[0, i + 1] * v[0, i + 1] + v[1, i + 1] * v[1, i + 1]))
-        s2 += free_mass[i + 2] * (lost[i + 2] - 0.5 * (v[0, i + 2] * v[0, i + 2] + v[1, i + 2] * v[1, i + 2]))
-        s3 += free_mass[i + 3] * (lost[i + 3] - 0.5 * (v[0, i + 3] * v[0, i + 3] + v[1, i + 3] * v[1, i + 3]))
-    for i in range(whole, n):
-        s0 += free_mass[i] * (lost[i] - 0.5 * (v[0, i] * v[0, i] + v[1, i] * v[1, i]))
-    return ((s0 + s1) + (s2 + s3)) + kinetic0
+    for i in range(v.shape[1]):
+        terms[i] = free_mass[i] * (lost[i] - 0.5 * (v[0, i] * v[0, i] + v[1, i] * v[1, i]))
+    return _lanes(terms) + kinetic0
 
 
 @njit(cache=True, error_model="numpy")
-def settle_drag(ledger, lost, v, free_mass, kinetic0, has_drag, held_idx):
+def chain_energy(x, v, mass, k, rest, closed, g, lengths, terms):
+    """(mechanical energy [J], largest spring length / rest length, that spring's first node) of the rope.
+
+    The quantities of :func:`ropesim.kernel.mechanical_energy` for a 2-D rope with only its springs and
+    gravity, in passes that vectorise and sums in a fixed order (``lengths`` and ``terms``, (N,), are
+    scratch). A non-finite state gives a non-finite energy.
+    """
+    n = x.shape[1]
+    springs = n if closed else n - 1
+    for i in range(n - 1):
+        d0 = x[0, i + 1] - x[0, i]
+        d1 = x[1, i + 1] - x[1, i]
+        lengths[i] = np.sqrt(d0 * d0 + d1 * d1)
+    if closed:
+        d0 = x[0, 0] - x[0, n - 1]
+        d1 = x[1, 0] - x[1, n - 1]
+        lengths[n - 1] = np.sqrt(d0 * d0 + d1 * d1)
+    for i in range(n):
+        terms[i] = 0.5 * mass[i] * (v[0, i] * v[0, i] + v[1, i] * v[1, i]) + mass[i] * g * x[1, i]
+    for i in range(springs):
+        e = lengths[i] - rest
+        terms[i] += 0.5 * k * e * e
+    m0 = m1 = m2 = m3 = 0.0
+    whole = springs - springs % LANES
+    for i in range(0, whole, LANES):
+        m0 = max(m0, lengths[i])
+        m1 = max(m1, lengths[i + 1])
+        m2 = max(m2, lengths[i + 2])
+        m3 = max(m3, lengths[i + 3])
+    for i in range(whole, springs):
+        m0 = max(m0, lengths[i])
+    worst = max(max(m0, m1), max(m2, m3))
+    node = -1
+    for i in range(springs):
+        if lengths[i] == worst:
+            node = i
+            break
+    return _lanes(terms), worst / rest, node
+
+
+@njit(cache=True, error_model="numpy")
+def settle_drag(ledger, lost, v, free_mass, kinetic0, has_drag, held_idx, terms):
     """Set ``ledger[DRAG]`` from the work booked in ``lost`` and the kinetic energy the free nodes gained [J].
 
     The held nodes' entries of ``lost`` hold whatever their bulk kick booked, and are cleared first.
@@ -111,24 +145,25 @@ def settle_drag(ledger, lost, v, free_mass, kinetic0, has_drag, held_idx):
     if has_drag:
         for j in range(held_idx.shape[0]):
             lost[held_idx[j]] = 0.0
-        ledger[DRAG] = settle(lost, v, free_mass, kinetic0)
+        ledger[DRAG] = settle(lost, v, free_mass, kinetic0, terms)
 
 
 @njit(cache=True, error_model="numpy")
 def advance_chain(x, v, f, lost, ledger, have_acc, step0, n_steps, total_steps, h, drift, kick, bulk, exceptions,
-                  exception_factors, saved, reuse_force, held, mass, forces, free_mass, kinetic0, has_drag, limits,
-                  save_every, frames, check_every):
+                  exception_factors, saved, reuse_force, held, mass, forces, free_mass, kinetic0, has_drag, scratch,
+                  limits, save_every, frames, check_every):
     """Advance ``n_steps`` splitting steps of a 2-D spring rope in place; the contract of ``integrators.advance``.
 
     ``f`` (2, N + 1) holds the spring forces [N] (kept between calls when the last kick's forces are reused),
     ``lost`` (N,) each node's accumulated work per unit mass [J/kg], ``bulk`` and ``exception_factors`` the kick factors (see
-    :class:`ChainState`), ``saved`` the exceptions' scratch. Returns (steps done, frames written, status, node).
+    :class:`ChainState`), ``saved`` the exceptions' scratch, ``scratch`` the blow-up check's. Returns (steps done, frames written, status, node).
     """
     n = x.shape[1]
     px, py, vx, vy, fx, fy = x[0], x[1], v[0], v[1], f[0], f[1]
     held_idx, held_x0, held_v = held
     inv_mass, flags, spring, bending, gravity, thrower, guides = forces
     saved_x, saved_v, saved_lost = saved
+    lengths, terms = scratch
     frames_t, frames_x, frames_v, frames_ledger = frames
     k, rest, closed = spring[0], spring[1], spring[2] != 0.0
     g = gravity[0] if flags[GRAVITY] else 0.0
@@ -140,7 +175,8 @@ def advance_chain(x, v, f, lost, ledger, have_acc, step0, n_steps, total_steps, 
         fx[0] = fx[n] = fy[0] = fy[n] = 0.0
     held_work = ledger[HELD]   # kept in a register, stored whenever the ledger is read
     frame = 0
-    due = _next_due(step0, total_steps, save_every, check_every)
+    next_check = step0 + check_every - step0 % check_every   # counted, not divided, per step
+    next_save = step0 + save_every - step0 % save_every
     for s in range(n_steps):
         step = step0 + s
         t = step * h
@@ -243,25 +279,23 @@ def advance_chain(x, v, f, lost, ledger, have_acc, step0, n_steps, total_steps, 
             held_work += kick[st] * h * p
         have_acc[0] = reuse_force
         done = step + 1
-        if done < due:
+        if done < next_check and done < next_save and done != total_steps:
             continue
+        saving = done == next_save or done == total_steps
+        if done == next_check:
+            next_check += check_every
+        if done == next_save:
+            next_save += save_every
         ledger[HELD] = held_work
-        settle_drag(ledger, lost, v, free_mass, kinetic0, has_drag, held_idx)
-        energy, stretch, worst = rope_energy(x, v, mass, k, rest, closed, g)
+        settle_drag(ledger, lost, v, free_mass, kinetic0, has_drag, held_idx, terms)
+        energy, stretch, worst = chain_energy(x, v, mass, k, rest, closed, g, lengths, terms)
         status, node = verdict(energy, stretch, worst, x, v, ledger, limits)
         if status != OK:
             return s + 1, frame, status, node
-        if done % save_every == 0 or done == total_steps:
+        if saving:
             save_frame(frame, done * h, x, v, ledger, frames_t, frames_x, frames_v, frames_ledger)
             frame += 1
-        due = _next_due(done, total_steps, save_every, check_every)
     ledger[HELD] = held_work
-    settle_drag(ledger, lost, v, free_mass, kinetic0, has_drag, held_idx)
+    settle_drag(ledger, lost, v, free_mass, kinetic0, has_drag, held_idx, terms)
     return n_steps, frame, OK, -1
 
-
-@njit(cache=True)
-def _next_due(done, total_steps, save_every, check_every):
-    """The first global step after ``done`` at which a check or a frame is due."""
-    due = min(done + check_every - done % check_every, done + save_every - done % save_every)
-    return min(due, total_steps) if total_steps > done else due

@@ -80,19 +80,12 @@ def mechanical_energy(x, v, mass, forces):
     Checked every few steps by the run loop to catch a blow-up (runaway energy or an insane stretch).
     """
     inv_mass, flags, spring, bending, gravity, thrower, guides = forces
+    dim, n = x.shape
     closed = spring[2] != 0.0
-    g = gravity[0] if flags[GRAVITY] else 0.0
-    e, stretch, node = rope_energy(x, v, mass, spring[0], spring[1], closed, g)
+    e, stretch, node = _springs_energy_and_stretch(x, spring[0], spring[1], 1, closed)
     if flags[BENDING]:
         e += _springs_energy_and_stretch(x, bending[0], bending[1], 2, closed)[0]
-    return e, stretch, node
-
-
-@njit(cache=True, error_model="numpy")
-def rope_energy(x, v, mass, k, rest, closed, g):
-    """:func:`mechanical_energy` of a rope with its own springs (k [N/m], rest [m]) and gravity g [m/s^2] only."""
-    dim, n = x.shape
-    e, stretch, node = _springs_energy_and_stretch(x, k, rest, 1, closed)
+    g = gravity[0] if flags[GRAVITY] else 0.0
     for i in range(n):
         v2 = 0.0
         for d in range(dim):

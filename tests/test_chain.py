@@ -147,3 +147,24 @@ def test_a_blow_up_on_the_fast_path_is_caught_and_named(scenarios):
     (fast, _, (done_a, _, status_a, node_a)), (general, _, (done_b, _, status_b, node_b)) = _both(scene, "verlet")
     assert status_a != 0 and (done_a, status_a, node_a) == (done_b, status_b, node_b)
     assert done_a < TimeGrid.of(scene).steps / 10
+
+
+@pytest.mark.parametrize("closed", [False, True])
+def test_the_fast_check_measures_what_the_general_one_does(tmp_path, closed):
+    """Energy to round-off, and the same worst spring, as ropesim.kernel.mechanical_energy; NaN stays NaN."""
+    from ropesim.kernel import mechanical_energy
+
+    text = LOOP if closed else LOOP.replace("closed = true", "closed = false").replace(
+        'shape = "square_loop"\ntop_center = [0.0, 0.0]', 'shape = "line"\nstart = [0.0, 0.0]\nend = [1.1, -0.3]')
+    model = build(_scene(tmp_path, text))
+    rng = np.random.default_rng(7)
+    x = model.x0 + rng.normal(scale=0.01, size=model.x0.shape)
+    v = rng.normal(size=model.x0.shape)
+    lengths, terms = np.zeros(model.nodes), np.zeros(model.nodes)
+    spring, g = model.forces[2], model.forces[4][0]
+    fast = chain.chain_energy(x, v, model.mass, spring[0], spring[1], closed, g, lengths, terms)
+    general = mechanical_energy(x, v, model.mass, model.forces)
+    assert fast[0] == pytest.approx(general[0], rel=1e-12)
+    assert fast[1:] == general[1:]
+    x[1, 3] = np.nan
+    assert not np.isfinite(chain.chain_energy(x, v, model.mass, spring[0], spring[1], closed, g, lengths, terms)[0])
