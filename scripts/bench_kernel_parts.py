@@ -2,11 +2,11 @@
 work term each switched off.
 
 Same towed rope and yardstick as ``scripts/bench_kernel.py``. ropesim's loop (:func:`ropesim.chain.advance_chain`)
-is called directly, four ways, interleaved with the yardstick in one process:
+is called directly three ways, interleaved with the yardstick in one process:
 
 - as run (blow-up check every 64 steps, the drag loss booked in every kick);
 - without the blow-up check (and so without forming the drag loss for it);
-- without the check and without the kick's work term (the loop a scene without drag runs);
+- without the check and without the kick's work term (the loop a scene without drag runs).
 
 The switched-off variants are for measuring only: without the work term the ledger's drag loss is not kept.
 
