@@ -100,11 +100,9 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
             ax.set_title(f"t = {t:.2f} s", fontsize=9, pad=3)
         for ax in axes[len(frames):]:
             ax.set_visible(False)
-        fig.supxlabel(axes[0].get_xlabel(), fontsize=8)
         fig.supylabel(axes[0].get_ylabel(), fontsize=8)
         for ax in axes:
-            ax.label_outer()
-            ax.set_xlabel("")
+            ax.label_outer()   # x labels stay under the bottom row, where the layout leaves the legend room
             ax.set_ylabel("")
     header = model.scene.name + (f"  ·  view {''.join(proj.names)}" if traj.scene.dimension == 3 else "")
     fig.suptitle(header, x=0.01, ha="left", fontsize=10, fontweight="bold")
