@@ -155,8 +155,9 @@ def advance_chain(x, v, f, lost, ledger, have_acc, step0, n_steps, total_steps, 
     """Advance ``n_steps`` splitting steps of a 2-D spring rope in place; the contract of ``integrators.advance``.
 
     ``f`` (2, N + 1) holds the spring forces [N] (kept between calls when the last kick's forces are reused),
-    ``lost`` (N,) each node's accumulated work per unit mass [J/kg], ``bulk`` and ``exception_factors`` the kick factors (see
-    :class:`ChainState`), ``saved`` the exceptions' scratch, ``scratch`` the blow-up check's. Returns (steps done, frames written, status, node).
+    ``lost`` (N,) each node's accumulated work per unit mass [J/kg], ``bulk`` and ``exception_factors`` the
+    kick factors (see :class:`ChainState`), ``saved`` the exceptions' scratch and ``scratch`` the blow-up
+    check's. Returns (steps done, frames written, status, node).
     """
     n = x.shape[1]
     px, py, vx, vy, fx, fy = x[0], x[1], v[0], v[1], f[0], f[1]
