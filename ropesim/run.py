@@ -90,6 +90,7 @@ class Stepper:
         self.limits = np.array([stretch_limit(model), RUNAWAY_FACTOR, RUNAWAY_FLOW_FRACTION])
         self.held = (model.held_idx, model.held_x0, model.held_v)
         kind = self.scheme.kind
+        self.chain = None
         if kind == "splitting":
             self.reuse_force = self.scheme.reuses_last_force and not model.velocity_dependent
             self.drift = np.array(self.scheme.drift)
