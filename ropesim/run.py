@@ -164,7 +164,7 @@ class Stepper:
 
             c = self.chain
             done, written, status, node = advance_chain(
-                self.x, self.v, c.forces, c.lost, self.ledger, self.have_acc, self.step, n, g.steps, g.dt, self.drift,
+                self.x, self.v, c.spring_forces, c.lost, self.ledger, self.have_acc, self.step, n, g.steps, g.dt, self.drift,
                 self.kick, c.bulk, c.exceptions, c.exception_factors, c.saved, self.reuse_force, self.held, m.mass,
                 m.forces, c.free_mass, c.kinetic0, c.has_drag, c.scratch, self.limits, g.save_every, frames,
                 CHECK_EVERY)

@@ -51,7 +51,7 @@ def contenders(n: int, steps: int) -> dict:
         c, m = st.chain, st.model
 
         def run(st=st, c=c, m=m, check_every=check_every, work=work):
-            advance_chain(st.x, st.v, c.forces, c.lost, st.ledger, st.have_acc, st.step, steps, NEVER, h, st.drift,
+            advance_chain(st.x, st.v, c.spring_forces, c.lost, st.ledger, st.have_acc, st.step, steps, NEVER, h, st.drift,
                           st.kick, c.bulk, c.exceptions, c.exception_factors, c.saved, st.reuse_force, st.held,
                           m.mass, m.forces, c.free_mass, c.kinetic0, work, c.scratch, st.limits, NEVER,
                           st.new_frames(0), check_every)
