@@ -60,6 +60,12 @@ def yardstick(x, v, f, steps, h, k, rest, inv_m, g, decay, gain, x0, vx, t0):
         py[0] = x0[1]
 
 
+
+def drag_factors(h: float) -> tuple[float, float]:
+    """(decay, gain) of the exact drag kick over a step h [s]: v <- decay v + gain a, with gamma = b / m."""
+    gamma = B / M
+    return math.exp(-gamma * h), -math.expm1(-gamma * h) / gamma
+
 class NumpyStep:
     """The same step with whole-array NumPy operations on (2, N) arrays."""
 
@@ -96,8 +102,7 @@ def compare(n: int, repeats: int, work: float) -> tuple:
     scene = towed_scene(n, "symplectic_euler", steps * (repeats + 2))
     stepper = stepper_for(scene)
     h = stepper.grid.dt
-    gamma = B / M
-    decay, gain = math.exp(-gamma * h), -math.expm1(-gamma * h) / gamma
+    decay, gain = drag_factors(h)
     xy, vy = stepper.x.copy(), stepper.v.copy()
     f = np.zeros((2, n + 1))
     yardstick(xy.copy(), vy.copy(), f, 1, h, K, L0, 1.0 / M, G, decay, gain, xy[:, 0].copy(), V, 0.0)  # compile
@@ -127,8 +132,7 @@ def same_physics(n: int, steps: int) -> float:
     """Largest difference [m] between the three contenders' positions after ``steps`` steps from rest."""
     stepper = stepper_for(towed_scene(n, "symplectic_euler", steps))
     h = stepper.grid.dt
-    gamma = B / M
-    decay, gain = math.exp(-gamma * h), -math.expm1(-gamma * h) / gamma
+    decay, gain = drag_factors(h)
     x, v = stepper.x.copy(), stepper.v.copy()
     npstep = NumpyStep(stepper.x.copy(), stepper.v.copy())
     yardstick(x, v, np.zeros((2, n + 1)), steps, h, K, L0, 1.0 / M, G, decay, gain, x[:, 0].copy(), V, 0.0)

@@ -16,13 +16,12 @@ The switched-off variants are for measuring only: without the work term the ledg
 from __future__ import annotations
 
 import argparse
-import math
 
 import numpy as np
 from rich.console import Console
 from rich.table import Table
 
-from bench_kernel import B, G, K, L0, M, V, yardstick
+from bench_kernel import G, K, L0, M, V, drag_factors, yardstick
 from benchlib import interleaved, load_note, median, stepper_for, towed_scene
 
 NEVER = 2 ** 62   # a check or frame interval no run reaches
@@ -34,7 +33,7 @@ def contenders(n: int, steps: int) -> dict:
     scene = towed_scene(n, "symplectic_euler", steps * 100)
     ref = stepper_for(scene)
     h = ref.grid.dt
-    decay, gain = math.exp(-B / M * h), -math.expm1(-B / M * h) / (B / M)
+    decay, gain = drag_factors(h)
     x, v, f = ref.x.copy(), ref.v.copy(), np.zeros((2, n + 1))
     x0, done = x[:, 0].copy(), [0]
 
