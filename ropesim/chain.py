@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .health import DRAG, HELD, OK, save_frame, verdict
+from .health import BOX, DRAG, E0, HELD, OK, SCALE, balance_status, save_frame, verdict
 from .kernel import BENDING, GRAVITY, GUIDES, THROWER
 from .kick import LANES, _lanes
 
@@ -83,7 +83,7 @@ class ChainState:
         self.has_drag = bool(np.any(drag[free] > 0.0))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def settle(lost, v, free_mass, kinetic0, terms):
     """sum_i m_i (lost_i - |v_i|^2 / 2) + kinetic0 over the free nodes (m_i = 0 at held ones), in a fixed order.
 
@@ -95,7 +95,7 @@ def settle(lost, v, free_mass, kinetic0, terms):
     return _lanes(terms) + kinetic0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def chain_energy(x, v, mass, k, rest, closed, g, lengths, terms):
     """(mechanical energy [J], largest spring length / rest length, that spring's first node) of the rope.
 
@@ -136,7 +136,7 @@ def chain_energy(x, v, mass, k, rest, closed, g, lengths, terms):
     return _lanes(terms), worst / rest, node
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def settle_drag(ledger, lost, v, free_mass, kinetic0, has_drag, held_idx, terms):
     """Set ``ledger[DRAG]`` from the work booked in ``lost`` and the kinetic energy the free nodes gained [J].
 
@@ -175,6 +175,7 @@ def advance_chain(x, v, f, lost, ledger, have_acc, step0, n_steps, total_steps, 
     if not closed:
         fx[0] = fx[n] = fy[0] = fy[n] = 0.0
     held_work = ledger[HELD]   # kept in a register, stored whenever the ledger is read
+    max_stretch, of_scale, of_flows = limits[0], limits[1], limits[2]
     frame = 0
     next_check = step0 + check_every - step0 % check_every   # counted, not divided, per step
     next_save = step0 + save_every - step0 % save_every
@@ -290,9 +291,12 @@ def advance_chain(x, v, f, lost, ledger, have_acc, step0, n_steps, total_steps, 
         ledger[HELD] = held_work
         settle_drag(ledger, lost, v, free_mass, kinetic0, has_drag, held_idx, terms)
         energy, stretch, worst = chain_energy(x, v, mass, k, rest, closed, g, lengths, terms)
-        status, node = verdict(energy, stretch, worst, x, v, ledger, limits)
-        if status != OK:
-            return s + 1, frame, status, node
+        status = balance_status(energy, stretch, held_work, ledger[BOX], ledger[DRAG], ledger[E0], ledger[SCALE],
+                                max_stretch, of_scale, of_flows)
+        if status != OK or not np.isfinite(energy):   # only now hand the arrays over, to name the culprit
+            status, node = verdict(energy, stretch, worst, x, v, ledger, limits)
+            if status != OK:
+                return s + 1, frame, status, node
         if saving:
             save_frame(frame, done * h, x, v, ledger, frames_t, frames_x, frames_v, frames_ledger)
             frame += 1

@@ -58,6 +58,21 @@ def check_health(x, v, mass, forces, ledger, limits):
     return verdict(energy, stretch, node, x, v, ledger, limits)
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def balance_status(energy, stretch, held, box, drag, e0, scale, max_stretch, of_scale, of_flows):
+    """OVERSTRETCH, RUNAWAY_ENERGY or OK from the energy [J], worst stretch and ledger entries alone.
+
+    Scalars only, so the compiled loops can call it at every check without handing over arrays (whose
+    reference counting costs more than the test). A NaN energy passes; :func:`verdict` looks for its culprit.
+    """
+    if stretch > max_stretch:
+        return OVERSTRETCH
+    flowed = held + box - drag
+    if abs(energy - e0 - flowed) > of_scale * scale + of_flows * (abs(held) + abs(box) + drag):
+        return RUNAWAY_ENERGY
+    return OK
+
+
 @njit(cache=True, error_model="numpy")
 def verdict(energy, stretch, node, x, v, ledger, limits):
     """:func:`check_health` given the mechanical energy [J] and the worst stretch (and its node) of the state."""
@@ -67,11 +82,11 @@ def verdict(energy, stretch, node, x, v, ledger, limits):
             bad = first_non_finite(v)
         if bad >= 0:
             return NON_FINITE, bad
-    if stretch > limits[0]:
-        return OVERSTRETCH, node
-    flowed = ledger[HELD] + ledger[BOX] - ledger[DRAG]
-    scale = limits[1] * ledger[SCALE] + limits[2] * (abs(ledger[HELD]) + abs(ledger[BOX]) + ledger[DRAG])
-    if abs(energy - ledger[E0] - flowed) > scale:
+    status = balance_status(energy, stretch, ledger[HELD], ledger[BOX], ledger[DRAG], ledger[E0], ledger[SCALE],
+                            limits[0], limits[1], limits[2])
+    if status == OVERSTRETCH:
+        return status, node
+    if status == RUNAWAY_ENERGY:
         dim, n = v.shape
         fastest, best = 0, -1.0
         for i in range(n):
@@ -80,7 +95,7 @@ def verdict(energy, stretch, node, x, v, ledger, limits):
                 v2 += v[d, i] * v[d, i]
             if v2 > best:
                 best, fastest = v2, i
-        return RUNAWAY_ENERGY, fastest
+        return status, fastest
     return OK, -1
 
 

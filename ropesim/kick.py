@@ -20,7 +20,7 @@ LANES = 4   # running sums per reduction
 SCRATCH_NODES = 256   # from this many nodes kick_drift sums each node's loss over the rows before the lanes
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _lanes(t):
     """Sum of ``t`` as four running sums combined in a fixed order."""
     n = t.shape[0]
