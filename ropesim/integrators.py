@@ -172,14 +172,17 @@ def kick_factors(scheme: SplittingScheme, h: float, drag: np.ndarray, mass: np.n
     changes.
     """
     c = np.asarray(scheme.kick)[:, None] * h
-    gamma = np.broadcast_to((drag / mass)[None, :], (len(scheme.kick), len(mass)))
+    rate = drag / mass
+    rate[rate < np.finfo(float).tiny] = 0.0   # a subnormal b/m slows nothing, and its few bits would spoil gain
+    gamma = np.broadcast_to(rate[None, :], (len(scheme.kick), len(mass)))
     z = gamma * c
     decay = np.exp(-z)
     safe = np.where(gamma > 0, gamma, 1.0)
     gain = np.where(gamma > 0, -np.expm1(-z) / safe, c)
     small = np.abs(z) < 1e-3
     series = c * c * (0.5 - z / 6.0 + z * z / 24.0 - z ** 3 / 120.0)  # (z + expm1(-z)) c^2 / z^2 for small z
-    travel = np.where(small, series, (z + np.expm1(-z)) / (safe * safe))
+    beyond = np.where(small, 1.0, safe)   # gamma where the closed form serves; 1 elsewhere, where gamma^2 may underflow
+    travel = np.where(small, series, (z + np.expm1(-z)) / (beyond * beyond))
     decay[:, held] = 1.0
     gain[:, held] = 0.0
     travel[:, held] = 0.0

@@ -17,6 +17,8 @@ from . import scene as S
 
 
 MAX_STEPS = 1e12  # a run of more steps would take days; t_end / dt beyond it is a typo, not a plan
+MAX_MAGNITUDE = 1e12  # in SI units: 7 AU, 30 000 years, a 1e12 N/m spring; no rope scene needs more
+MIN_POSITIVE = 1e-12  # the least value of a quantity that must be > 0, so that ratios such as k / m stay finite
 
 
 class SceneError(ValueError):
@@ -284,9 +286,9 @@ def _check_scene(scene: S.Scene, source: str) -> S.Scene:
 
     if scene.thrower is not None and scene.thrower.omega0 is None:
         w = scene.thrower.resolved_omega0
-        if not 0 < w < math.inf:
-            fail("thrower.omega0", f"missing: its default 4 pi |v_max| / length is {w:g} rad/s here; give a "
-                                   f"finite omega0 > 0")
+        if not MIN_POSITIVE <= w <= MAX_MAGNITUDE:
+            fail("thrower.omega0", f"missing: its default 4 pi |v_max| / length is {w:g} rad/s here; give an "
+                                   f"omega0 from {MIN_POSITIVE:g} to {MAX_MAGNITUDE:g}")
         scene = replace(scene, thrower=replace(scene.thrower, omega0=w))
     guides = []
     for j, guide in enumerate(scene.guides):
@@ -333,6 +335,7 @@ def _value(value: Any, sp: S.Spec, key: str, source: str, dim: int):
             bad("must be a finite number")
         value = float(value)
         _bounds(value, sp, key, source, "a number")
+        _magnitude(value, sp, key, source)
         return value
     if sp.kind == "vector":
         return _vector(value, dim, key, source, sp)
@@ -356,7 +359,10 @@ def _vector(value, dim, key, source, sp):
     if not ok:
         raise SceneError(source, key, f"must be a list of {dim} finite numbers (dimension = {dim}){_unit(sp)}, "
                                       f"got {_show(value)}")
-    return tuple(float(v) for v in value)
+    vector = tuple(float(v) for v in value)
+    for v in vector:
+        _magnitude(v, sp, key, source, shown=value)
+    return vector
 
 
 def _finite(v) -> bool:
@@ -371,6 +377,17 @@ def _bounds(value, sp: S.Spec, key, source, what):
     high_ok = sp.high is None or value <= sp.high
     if not (low_ok and high_ok):
         raise SceneError(source, key, f"must be {_range(sp, what)}{_unit(sp)}, got {_show(value)}")
+
+
+def _magnitude(value: float, sp: S.Spec, key, source, shown: Any = None):
+    """Refuse numbers whose products would overflow: |value| <= MAX_MAGNITUDE, and >= MIN_POSITIVE when > 0 is
+    required (the products and ratios of a few such numbers stay far inside the float range)."""
+    if abs(value) > MAX_MAGNITUDE:
+        raise SceneError(source, key, f"must be at most {MAX_MAGNITUDE:g} in magnitude{_unit(sp)} (larger numbers "
+                                      f"overflow in products), got {_show(value if shown is None else shown)}")
+    if sp.open_low and sp.low == 0 and value < MIN_POSITIVE:
+        raise SceneError(source, key, f"must be at least {MIN_POSITIVE:g}{_unit(sp)} (smaller ones make ratios "
+                                      f"such as k / m overflow), got {_show(value if shown is None else shown)}")
 
 
 def _range(sp: S.Spec, what: str) -> str:
