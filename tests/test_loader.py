@@ -8,9 +8,10 @@ import math
 import re
 import tomllib
 import warnings
-from dataclasses import MISSING, fields
+from dataclasses import MISSING, fields, replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 import tomli_w
 from hypothesis import HealthCheck, given, settings
@@ -20,7 +21,7 @@ from ropesim import scene as S
 from ropesim.build import build
 from ropesim.loader import SceneError, apply_override, load_scene, parse_override, scene_from_toml
 from ropesim.analysis.stability import time_step_verdict
-from ropesim.run import Stepper, TimeGrid
+from ropesim.run import BLEW_UP, COMPLETED, Stepper, TimeGrid, simulate
 
 from conftest import ROOT, SCENARIOS
 
@@ -527,15 +528,30 @@ def _is_number(v) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
-@st.composite
-def perturbed_scenes(draw):
-    """A valid scene with one to three of its numbers replaced by edge values (zero, negative, huge, nan...)."""
+def _numbers_changed(draw, change):
+    """A valid scene with one to three of its numbers replaced by ``change(draw, old value)``."""
     raw = copy.deepcopy(draw(st.sampled_from(VALID_RAWS)))
     numeric = [(box, k) for box, k in _slots(raw) if _is_number(box[k])]
     for _ in range(draw(st.integers(1, 3))):
         box, k = draw(st.sampled_from(numeric))
-        box[k] = draw(numbers)
+        box[k] = change(draw, box[k])
     return raw
+
+
+@st.composite
+def perturbed_scenes(draw):
+    """A valid scene with one to three of its numbers replaced by edge values (zero, negative, huge, nan...)."""
+    return _numbers_changed(draw, lambda draw, old: draw(numbers))
+
+
+SCALES = [-1.0, 0.0, 1e-12, 1e-9, 1e-3, 0.1, 10.0, 1e3, 1e9, 1e12]
+
+
+@st.composite
+def rescaled_scenes(draw):
+    """A valid scene with one to three of its numbers scaled by 0, -1 or 10^-12 ... 10^12 (counts: -3 to 60)."""
+    return _numbers_changed(draw, lambda draw, old: draw(st.integers(-3, 60)) if isinstance(old, int)
+                            else old * draw(st.sampled_from(SCALES)))
 
 
 @st.composite
@@ -604,6 +620,28 @@ def test_random_set_overrides_are_accepted_or_refused_in_one_line(raw, items):
         text = tomli_w.dumps({"v": value}).partition("=")[2].strip() if not isinstance(value, dict) else "{}"
         sets.append(".".join(path) + "=" + text)
     _accepted_or_one_line(tomli_w.dumps(raw), sets)
+
+
+@FUZZ
+@given(rescaled_scenes())
+def test_rescaled_scenes_are_refused_in_one_line_or_run_cleanly(raw):
+    """Accepted, a scene runs 30 steps to 'completed' (every saved value finite) or 'blew_up' (named), with no
+    warning or exception on the way: setup, kernel, blow-up check, analyses."""
+    scene = _accepted_or_one_line(tomli_w.dumps(raw))
+    if scene is None:
+        return
+    dt = scene.integrator.dt
+    scene = replace(scene, integrator=replace(scene.integrator, t_end=30 * dt), output=replace(scene.output,
+                                                                                               interval=10 * dt))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        traj = simulate(scene)
+    status = traj.summary["status"]
+    assert status in (COMPLETED, BLEW_UP), status
+    if status == COMPLETED:
+        assert np.all(np.isfinite(traj.x)) and np.all(np.isfinite(traj.v))
+    else:
+        assert traj.summary["message"]
 
 
 @FUZZ
