@@ -169,16 +169,20 @@ def _dense_solve(a, rhs, work):
 
 
 @njit(cache=True, error_model="numpy")
-def _add(band, corner, n, dim, w, ni, nj, di, dj, value):
-    """Add ``value`` to A[ni*D+di, nj*D+dj] (lower triangle only; the wrap-around goes to ``corner``)."""
+def _slot(n, dim, w, ni, nj, di, dj):
+    """Where A[ni*D+di, nj*D+dj] is kept: (0, q, c) for band[q, c], (1, row, c) for the wrap-around's
+    corner[row, c], (-1, 0, 0) above the diagonal (only the lower triangle is stored).
+
+    Indices only: a helper that took the arrays would cost an atomic reference-count update per array and
+    call, which made assembly 15 times slower than the rest of a Newton iteration.
+    """
     r = ni * dim + di
     c = nj * dim + dj
     if r < c:
-        return
+        return -1, 0, 0
     if ni - nj <= w:
-        band[r - c, c] += value
-    else:
-        corner[(ni - (n - w)) * dim + di, c] += value
+        return 0, r - c, c
+    return 1, (ni - (n - w)) * dim + di, c
 
 
 @njit(cache=True, error_model="numpy")
@@ -186,15 +190,16 @@ def _add_pair(band, corner, n, dim, w, i, j, blk, free_i, free_j):
     """Add a spring's stiffness block: +blk to (i, i) and (j, j), -blk to (i, j) and (j, i)."""
     hi, lo = (i, j) if i > j else (j, i)
     free_hi, free_lo = (free_i, free_j) if i > j else (free_j, free_i)
-    for a in range(dim):
-        for b in range(dim):
-            val = blk[a, b]
-            if free_hi:
-                _add(band, corner, n, dim, w, hi, hi, a, b, val)
-            if free_lo:
-                _add(band, corner, n, dim, w, lo, lo, a, b, val)
-            if free_hi and free_lo:
-                _add(band, corner, n, dim, w, hi, lo, a, b, -val)
+    for ni, nj, sign, used in ((hi, hi, 1.0, free_hi), (lo, lo, 1.0, free_lo), (hi, lo, -1.0, free_hi and free_lo)):
+        if not used:
+            continue
+        for a in range(dim):
+            for b in range(dim):
+                where, q, c = _slot(n, dim, w, ni, nj, a, b)
+                if where == 0:
+                    band[q, c] += sign * blk[a, b]
+                elif where == 1:
+                    corner[q, c] += sign * blk[a, b]
 
 
 @njit(cache=True, error_model="numpy")
