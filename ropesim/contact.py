@@ -19,7 +19,7 @@ import math
 
 from numba import njit
 
-from .forces.thrower import box_weight, smooth_step
+from .forces.thrower import box_of, smooth_step, weight_at
 from .kernel import GUIDES, THROWER
 
 
@@ -39,6 +39,8 @@ def exact_contact_kicks(x, v, acc, out, nodes, tau, gamma, free, forces):
     ``gamma`` (N,) the drag rate b / m."""
     inv_mass, flags, spring, bending, gravity, thrower, guides = forces
     dim, n = x.shape
+    three_d = dim == 3
+    box = box_of(thrower)
     count = 0
     for i in range(n):
         if not free[i]:
@@ -46,7 +48,7 @@ def exact_contact_kicks(x, v, acc, out, nodes, tau, gamma, free, forces):
         gxx = gxy = gyy = gzz = 0.0
         outside = 1.0
         if flags[THROWER]:
-            s = box_weight(x, i, thrower)
+            s = weight_at(x[0, i], x[1, i], x[2, i] if three_d else 0.0, three_d, box)
             outside = 1.0 - s
             if s > 0.0:
                 gxx += s * thrower[6] * inv_mass[i]

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .forces.thrower import box_weight, smooth_step
+from .forces.thrower import box_of, smooth_step, weight_at
 from .health import BOX, DRAG, HELD, NEWTON_FAILED, OK, end_step, held_power, place_held, power
 from .kernel import BENDING, GUIDES, THROWER, accelerations, box_accelerations
 
@@ -232,6 +232,7 @@ def _assemble(x, v, band, corner, beta, mass, drag, free, forces, w, blk):
     """The Newton matrix M (1 + beta gamma) + beta^2 H + beta C_v into ``band`` (and ``corner``)."""
     inv_mass, flags, spring, bending, gravity, thrower, guides = forces
     dim, n = x.shape
+    box = box_of(thrower)
     band[:] = 0.0
     corner[:] = 0.0
     closed = spring[2] != 0.0
@@ -252,7 +253,7 @@ def _assemble(x, v, band, corner, beta, mass, drag, free, forces, w, blk):
             band[0, i * dim + d] += diag
         outside = 1.0
         if flags[THROWER]:
-            sb = box_weight(x, i, thrower)
+            sb = weight_at(x[0, i], x[1, i], x[2, i] if dim == 3 else 0.0, dim == 3, box)
             outside = 1.0 - sb
             if sb > 0.0:
                 band[0, i * dim] += sb * beta * thrower[6]

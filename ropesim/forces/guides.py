@@ -16,7 +16,7 @@ Parameters: one row per circle, float64 (M, 7): cx, cy, R, omega0^2, 2 zeta omeg
 import numpy as np
 from numba import njit
 
-from .thrower import box_weight, smooth_step
+from .thrower import box_of, smooth_step, weight_at
 
 GUIDE_PARAMS = 7
 
@@ -25,8 +25,10 @@ GUIDE_PARAMS = 7
 def add_guides(x, v, acc, circles, box, has_box, g):
     """Add the guide circles' accelerations [m/s^2]; ``box`` is the thrower's parameters if ``has_box``."""
     n = x.shape[1]
+    three_d = x.shape[0] == 3
+    cube = box_of(box)
     for i in range(n):
-        outside = 1.0 - box_weight(x, i, box) if has_box else 1.0
+        outside = 1.0 - weight_at(x[0, i], x[1, i], x[2, i] if three_d else 0.0, three_d, cube) if has_box else 1.0
         if outside == 0.0:
             continue
         lift = 0.0
