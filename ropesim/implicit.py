@@ -86,9 +86,9 @@ def scratch(dim: int, nodes: int, bending: bool, closed: bool) -> tuple:
     p = (w + 1) * dim - 1
     m = w * dim
     f = np.zeros
-    # band, W, Z, A00, G, S, corner, small, column, rhs, tmp, X, V, Xhat, Vhat, spring block
+    # band, W, Z, A00, G, S, corner, small, rhs, tmp, X, V, Xhat, Vhat, spring block
     return (f((p + 1, nt)), f((nt, m)), f((nt, m)), f((m, m)), f((m, m)), f((m, m)), f((m, m)), f((m, m + 1)),
-            f(nt), f(nt), f(m), f((dim, nodes)), f((dim, nodes)), f((dim, nodes)), f((dim, nodes)), f((dim, dim)))
+            f(nt), f(m), f((dim, nodes)), f((dim, nodes)), f((dim, nodes)), f((dim, nodes)), f((dim, dim)))
 
 
 # ----------------------------------------------------------------------------------- linear algebra
@@ -129,6 +129,27 @@ def _band_solve(band, p, r):
         for k in range(i + 1, min(nt, i + p + 1)):
             s -= band[k - i, i] * r[k]
         r[i] = s / band[0, i]
+
+
+@njit(cache=True, error_model="numpy")
+def _band_solve_columns(band, p, z):
+    """Solve L L^T Z = z in place for every column of ``z`` (nt, m) at once: the same operations, in the same
+    order, as :func:`_band_solve` on each column, with each entry of L loaded once for all columns."""
+    nt, m = z.shape
+    for i in range(nt):
+        for k in range(max(0, i - p), i):
+            lik = band[i - k, k]
+            for c in range(m):
+                z[i, c] -= lik * z[k, c]
+        for c in range(m):
+            z[i, c] /= band[0, i]
+    for i in range(nt - 1, -1, -1):
+        for k in range(i + 1, min(nt, i + p + 1)):
+            lki = band[k - i, i]
+            for c in range(m):
+                z[i, c] -= lki * z[k, c]
+        for c in range(m):
+            z[i, c] /= band[0, i]
 
 
 @njit(cache=True, error_model="numpy")
@@ -295,7 +316,7 @@ def _factor(band, corner, cyclic, p, work):
     2 A00 and its bottom-right gains C^T A00^-1 C, both still positive definite). Then
     A^-1 r = B^-1 r - Z S^-1 W^T B^-1 r with Z = B^-1 W and S = -A00^-1 + W^T Z.
     """
-    wmat, zmat, a00, g, s, small, col = work[1], work[2], work[3], work[4], work[5], work[7], work[8]
+    wmat, zmat, a00, g, s, small = work[1], work[2], work[3], work[4], work[5], work[7]
     nt = band.shape[1]
     m = a00.shape[0]
     if cyclic:
@@ -320,12 +341,8 @@ def _factor(band, corner, cyclic, p, work):
             wmat[a, a] = 1.0
             for b in range(m):
                 wmat[nt - m + a, b] = -g[b, a]
-        for b in range(m):
-            for r in range(nt):
-                col[r] = wmat[r, b]
-            _band_solve(band, p, col)
-            for r in range(nt):
-                zmat[r, b] = col[r]
+        zmat[:] = wmat
+        _band_solve_columns(band, p, zmat)
         for b in range(m):
             for a in range(m):
                 s[a, b] = 0.0
@@ -343,7 +360,7 @@ def _factor(band, corner, cyclic, p, work):
 @njit(cache=True, error_model="numpy")
 def _solve(band, cyclic, p, rhs, work):
     """Solve the factored Newton system in place into ``rhs`` (flat, node-major)."""
-    wmat, zmat, s, corner, small, tmp = work[1], work[2], work[5], work[6], work[7], work[10]
+    wmat, zmat, s, corner, small, tmp = work[1], work[2], work[5], work[6], work[7], work[9]
     nt = band.shape[1]
     _band_solve(band, p, rhs)
     if cyclic:
@@ -370,7 +387,7 @@ def _solve_stage(xh, vh, X, V, acc, beta, t_stage, held, free, mass, drag, force
     """Newton solve of one stage: X = xh + beta V, V = vh + beta (a(X, V) - gamma V). Returns
     (iterations, node): iterations < 0 when it failed, naming the node that moved most in the last one."""
     held_idx, held_x0, held_v = held
-    band, corner, rhs = work[0], work[6], work[9]
+    band, corner, rhs = work[0], work[6], work[8]
     dim, n = X.shape
     p = band.shape[0] - 1
     for d in range(dim):
@@ -425,8 +442,8 @@ def advance_sdirk(x, v, acc, acc_box, ledger, stats, step0, n_steps, total_steps
     held_idx, held_x0, held_v = held
     flags = forces[1]
     has_box = flags[THROWER] != 0 or flags[GUIDES] != 0
-    X, V, xh, vh = work[11], work[12], work[13], work[14]
-    blk = work[15]
+    X, V, xh, vh = work[10], work[11], work[12], work[13]
+    blk = work[14]
     beta = GAMMA * h
     frame = 0
     for s in range(n_steps):
