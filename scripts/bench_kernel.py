@@ -13,7 +13,8 @@ at 8 m/s, Hookean springs, gravity, linear drag integrated exactly in the kick, 
 
 All three start from the same state, run the same steps and end at the same positions (checked). They run
 interleaved in one process; the table shows the median rates and the median of the per-round ratios.
-Then node-steps per second for every integrator from N = 21 to N = 10^6.
+Then node-steps per second for every integrator from N = 21 to N = 10^6, and the cost of a step of every
+integrator on `shooter_high` (N = 60, the general loop with bending, thrower and guide circles).
 
     python scripts/bench_kernel.py [--repeats 7] [--work 2e7] [--sizes 21,60,1000] [--skip-methods]
 """
@@ -28,7 +29,7 @@ from numba import njit
 from rich.console import Console
 from rich.table import Table
 
-from benchlib import interleaved, load_note, median, median_ratio, rate, stepper_for, towed_scene
+from benchlib import ROOT, interleaved, load_note, median, median_ratio, rate, stepper_for, towed_scene
 
 L0, K, M, B, G, V = 0.5, 5000.0, 5.0, 5.0, 9.81, 8.0   # helicopter_uniform's rope, drag and tow speed
 
@@ -156,6 +157,21 @@ def method_rates(sizes: list[int], work: float, repeats: int) -> dict:
     return out
 
 
+def shooter_step_times(repeats: int) -> dict:
+    """Median wall time [s] of one step of every integrator on scenarios/shooter_high.toml."""
+    import ropesim
+    from ropesim.integrators import METHODS
+
+    out = {}
+    for name, method in METHODS.items():
+        steps = 200 if method.kind == "implicit" else 5000
+        scene = ropesim.load_scene(ROOT / "scenarios" / "shooter_high.toml",
+                                   [f"integrator.method={name}", f"integrator.t_end={steps * (repeats + 2) * 1e-3!r}"])
+        stepper = stepper_for(scene)
+        out[name] = median(interleaved({"run": lambda: stepper.advance(steps)}, repeats)["run"]) / steps
+    return out
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=7)
@@ -191,6 +207,12 @@ def main() -> None:
 
     for name in METHODS:
         table.add_row(name, *(rate(rates[name, n], 1) for n in sizes))
+    console.print(table)
+    table = Table(title="Every integrator, shooter_high (N = 60, general loop): one step (median)")
+    table.add_column("method")
+    table.add_column("per step", justify="right")
+    for name, t in shooter_step_times(max(3, args.repeats // 2)).items():
+        table.add_row(name, f"{t * 1e6:,.1f} µs")
     console.print(table)
     console.print(load_note())
 
