@@ -1,23 +1,33 @@
 """Where Numba keeps ropesim's compiled kernels, so a second run loads them instead of compiling again.
 
-Numba caches a ``cache=True`` function in the ``__pycache__`` folder beside its source file, and when that
-folder cannot be written (a package installed into a read-only location) it tries the user-wide
-``~/.cache/numba``; when neither can be written it refuses to define the function at all, so importing
-ropesim would fail. :func:`ensure_writable_cache` runs before any kernel is defined and, only when the package
-folder is not writable and the user has not set ``NUMBA_CACHE_DIR``, points ``NUMBA_CACHE_DIR`` at the first
-writable of the user cache folder (``$XDG_CACHE_HOME/ropesim/numba`` or ``~/.cache/ropesim/numba``; the
-platform's equivalent on macOS and Windows) and a per-user folder in the temporary directory. It never
-imports numba, so it costs the command line nothing measurable.
+Numba caches a ``cache=True`` function beside its source file (in ``__pycache__``) and checks only that one
+file's time stamp when it loads it. A kernel inlines helpers from other modules, so after an edit to a helper
+alone (``forces/thrower.py``, say) Numba would go on loading the kernel compiled with the old helper: stale
+physics, silently. And when the package folder cannot be written (an install into a read-only place) it
+tries ``~/.cache/numba``, and when that cannot be written either it refuses to define the function, so
+importing ropesim would fail.
+
+So, unless the user has set ``NUMBA_CACHE_DIR``, :func:`ensure_writable_cache` (run before any kernel is
+defined) points it at a folder named by a fingerprint of every source file of the package (path, size and
+modification time): any edit anywhere in ropesim starts a fresh folder, and every kernel compiles anew.
+The folder lies under the first writable of the package's ``__pycache__/kernels``, the user cache folder
+(``$XDG_CACHE_HOME/ropesim/numba`` or ``~/.cache/ropesim/numba``; the platform's equivalent on macOS and
+Windows) and a per-user folder in the temporary directory; the most recently used few are kept, older
+ones deleted. It never imports numba, and the fingerprint (a stat per source file) costs well under a
+millisecond.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
+import shutil
 import sys
 import tempfile
 from pathlib import Path
 
 PACKAGE_DIR = Path(__file__).resolve().parent
+KEEP = 3   # kernel folders kept per cache location (the current one and the two used before it)
 
 
 def writable(folder: Path) -> bool:
@@ -51,24 +61,45 @@ def temp_cache_dir() -> Path:
     return Path(tempfile.gettempdir()) / f"ropesim-kernels-{user}"
 
 
-def choose_cache_dir(package_dir: Path = PACKAGE_DIR, environ=os.environ) -> str | None:
-    """The folder to give Numba as ``NUMBA_CACHE_DIR``, or None to leave Numba's own choice alone.
+def source_fingerprint(package_dir: Path = PACKAGE_DIR) -> str:
+    """12 hex digits that change whenever any ``.py`` file of the package is added, removed or modified."""
+    digest = hashlib.sha1()
+    for path in sorted(package_dir.rglob("*.py")):
+        stat = path.stat()
+        digest.update(f"{path.relative_to(package_dir).as_posix()}:{stat.st_size}:{stat.st_mtime_ns}\n".encode())
+    return digest.hexdigest()[:12]
 
-    None when the user set ``NUMBA_CACHE_DIR`` or the package's ``__pycache__`` is writable (an editable or
-    user-owned install); otherwise the first writable of :func:`user_cache_dir` and :func:`temp_cache_dir`.
+
+def prune(base: Path, keep: Path, count: int = KEEP) -> None:
+    """Delete the kernel folders in ``base`` beyond the ``count`` most recently used (``keep`` among them)."""
+    try:
+        os.utime(keep)   # marks it used now
+        others = sorted((p for p in base.iterdir() if p.is_dir() and p != keep),
+                        key=lambda p: p.stat().st_mtime, reverse=True)
+    except OSError:
+        return
+    for old in others[count - 1:]:
+        shutil.rmtree(old, ignore_errors=True)
+
+
+def choose_cache_dir(package_dir: Path = PACKAGE_DIR, environ=os.environ) -> str | None:
+    """The folder to give Numba as ``NUMBA_CACHE_DIR``, or None to leave the user's own setting alone.
+
+    The fingerprint's folder (see the module doc) under the first writable of the package's
+    ``__pycache__/kernels``, :func:`user_cache_dir` and :func:`temp_cache_dir`.
     """
     if environ.get("NUMBA_CACHE_DIR"):
         return None
-    if writable(package_dir / "__pycache__") and writable(package_dir / "forces" / "__pycache__"):
-        return None
-    for candidate in (user_cache_dir(), temp_cache_dir()):
-        if candidate is not None and writable(candidate):
-            return str(candidate)
+    fingerprint = source_fingerprint(package_dir)
+    for base in (package_dir / "__pycache__" / "kernels", user_cache_dir(), temp_cache_dir()):
+        if base is not None and writable(base / fingerprint):
+            prune(base, base / fingerprint)
+            return str(base / fingerprint)
     return None
 
 
 def ensure_writable_cache() -> str | None:
-    """Set ``NUMBA_CACHE_DIR`` when ropesim's own folder cannot hold the cache; returns the folder chosen."""
+    """Set ``NUMBA_CACHE_DIR`` to :func:`choose_cache_dir`'s folder (unless the user set it); returns it."""
     chosen = choose_cache_dir()
     if chosen is None:
         return None

@@ -1,7 +1,8 @@
 """What the speed-ups must never change, checked without timing anything.
 
-- The compile cache: a kernel compiled in one process loads from the cache in the next, and an install
-  whose package folder cannot be written still gets a writable cache folder (ropesim/numba_cache.py).
+- The compile cache: a kernel compiled in one process loads from the cache in the next, an edit to any
+  module starts a fresh cache folder, and an install whose package folder cannot be written still gets a
+  writable cache folder (ropesim/numba_cache.py).
 - Memory: a run folder's frames stream to disk, so the memory a run allocates does not grow with the
   number of saved frames (counted with tracemalloc, which sees NumPy's allocations).
 - Parallel kernels give bit-identical results to the serial ones.
@@ -34,11 +35,43 @@ def _blocked(tmp_path: Path) -> Path:
     return plain / "folder"
 
 
-def test_cache_dir_left_to_numba_when_the_package_is_writable(tmp_path):
+def _package(tmp_path: Path) -> Path:
     package = tmp_path / "ropesim"
     (package / "forces").mkdir(parents=True)
-    assert numba_cache.choose_cache_dir(package, environ={}) is None
-    assert (package / "__pycache__").is_dir()
+    (package / "kernel.py").write_text("x = 1\n")
+    (package / "forces" / "thrower.py").write_text("y = 2\n")
+    return package
+
+
+def test_writable_package_caches_in_its_own_pycache_under_its_fingerprint(tmp_path):
+    package = _package(tmp_path)
+    chosen = numba_cache.choose_cache_dir(package, environ={})
+    assert chosen == str(package / "__pycache__" / "kernels" / numba_cache.source_fingerprint(package))
+    assert numba_cache.writable(Path(chosen))
+
+
+def test_an_edit_to_any_module_starts_a_fresh_kernel_folder(tmp_path):
+    """Numba checks only the defining file's stamp, so a kernel compiled with an old helper from another module
+    would load after the helper changed; the fingerprint covers every module instead."""
+    package = _package(tmp_path)
+    before = numba_cache.choose_cache_dir(package, environ={})
+    helper = package / "forces" / "thrower.py"
+    helper.write_text("y = 3\n")   # same size: only the modification time tells
+    os.utime(helper, ns=(helper.stat().st_atime_ns, helper.stat().st_mtime_ns + 1_000_000))
+    after = numba_cache.choose_cache_dir(package, environ={})
+    assert after != before
+    (package / "forces" / "guides.py").write_text("")
+    assert numba_cache.choose_cache_dir(package, environ={}) not in (before, after)
+
+
+def test_only_the_most_recently_used_kernel_folders_are_kept(tmp_path):
+    package = _package(tmp_path)
+    base = package / "__pycache__" / "kernels"
+    for age, name in enumerate(["old3", "old2", "old1", "old0"]):
+        (base / name).mkdir(parents=True)
+        os.utime(base / name, (1e9 - age, 1e9 - age))   # old0 the oldest
+    chosen = Path(numba_cache.choose_cache_dir(package, environ={}))
+    assert sorted(p.name for p in base.iterdir()) == sorted([chosen.name, "old3", "old2"])
 
 
 def test_cache_dir_respects_the_users_numba_cache_dir(tmp_path):
@@ -49,7 +82,7 @@ def test_read_only_install_caches_in_the_user_cache_folder(tmp_path, monkeypatch
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
     monkeypatch.setattr(sys, "platform", "linux")
     chosen = numba_cache.choose_cache_dir(_blocked(tmp_path), environ={})
-    assert chosen == str(tmp_path / "xdg" / "ropesim" / "numba")
+    assert Path(chosen).parent == tmp_path / "xdg" / "ropesim" / "numba"
     assert numba_cache.writable(Path(chosen))
 
 
@@ -59,7 +92,7 @@ def test_read_only_install_without_a_writable_home_caches_in_the_temporary_folde
     monkeypatch.setattr(numba_cache.tempfile, "tempdir", str(tmp_path / "tmp"))
     (tmp_path / "tmp").mkdir()
     chosen = numba_cache.choose_cache_dir(_blocked(tmp_path), environ={})
-    assert chosen is not None and Path(chosen).parent == tmp_path / "tmp"
+    assert chosen is not None and Path(chosen).parent.parent == tmp_path / "tmp"
 
 
 def test_ensure_writable_cache_tells_an_already_imported_numba(tmp_path, monkeypatch):
