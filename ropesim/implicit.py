@@ -195,7 +195,7 @@ def _slot(n, dim, w, ni, nj, di, dj):
     corner[row, c], (-1, 0, 0) above the diagonal (only the lower triangle is stored).
 
     Indices only: a helper that took the arrays would cost an atomic reference-count update per array and
-    call, which made assembly 15 times slower than the rest of a Newton iteration.
+    call; twelve such calls per spring made assembly ten times slower (366 ns per node against 35).
     """
     r = ni * dim + di
     c = nj * dim + dj

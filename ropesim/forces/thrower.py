@@ -38,8 +38,8 @@ def box_of(p):
     """The box's centre, half-length, half-width and edge width (cx, cy, cz, L/2, W/2, w), a tuple of floats.
 
     The per-node weight takes this tuple and the node's coordinates, all passed by value: a helper taking
-    arrays costs an atomic reference-count update per array and call, which made the shooter's force
-    evaluation ten times slower than the rope's own springs.
+    arrays costs an atomic reference-count update per array and call, which made a shooter step six times
+    slower (12.9 us against 2.0 at N = 60).
     """
     return p[0], p[1], p[2], p[3], p[4], p[9]
 
