@@ -64,7 +64,8 @@ class ChainState:
             m_bulk, b_bulk = mass[0], drag[0]
         bulk_node = free & (mass == m_bulk) & (drag == b_bulk)
         like = int(np.flatnonzero(bulk_node)[0]) if bulk_node.any() else 0
-        reach = travel / np.where(gain != 0.0, gain, 1.0)   # gain is 0 only at held nodes, which book no work
+        with np.errstate(invalid="ignore"):   # inf / inf where a forced run's backward kick overflowed
+            reach = travel / np.where(gain != 0.0, gain, 1.0)   # gain is 0 only at held nodes, which book no work
         stages = decay.shape[0]
         self.bulk = np.empty(BULK_FIXED + BULK_PER_STAGE * stages)
         self.bulk[0] = model.forces[0][like]

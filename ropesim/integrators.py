@@ -88,7 +88,12 @@ class SplittingScheme:
 
 
 def _stable(method, h: float, omega: float, gamma_force: float, gamma_drag: float) -> bool:
-    m = method.amplification(h, omega, gamma_force, gamma_drag)
+    try:
+        m = method.amplification(h, omega, gamma_force, gamma_drag)
+    except OverflowError:   # a backward kick's e^(gamma |c| h) beyond the float range: the kernel's factor is inf
+        return False
+    if not np.all(np.isfinite(m)):
+        return False
     return bool(np.max(np.abs(np.linalg.eigvals(m))) <= 1.0 + 1e-9)
 
 
@@ -105,7 +110,8 @@ def stable_step(method, omega: float, gamma_force: float = 0.0, gamma_drag: floa
     rate = max(omega, gamma_force + (gamma_drag if method.kind == "rk" else 0.0))
     if rate <= 0.0:
         return math.inf
-    h, factor = 1e-3 / rate, 1.01
+    backward = method.kind == "splitting" and min(method.kick) < 0.0   # its backward kicks amplify by drag
+    h, factor = 1e-3 / max(rate, gamma_drag if backward else 0.0), 1.01
     while h * rate < 20.0 and _stable(method, h * factor, omega, gamma_force, gamma_drag):
         h *= factor
     lo, hi = h, h * factor
@@ -176,13 +182,16 @@ def kick_factors(scheme: SplittingScheme, h: float, drag: np.ndarray, mass: np.n
     rate[rate < np.finfo(float).tiny] = 0.0   # a subnormal b/m slows nothing, and its few bits would spoil gain
     gamma = np.broadcast_to(rate[None, :], (len(scheme.kick), len(mass)))
     z = gamma * c
-    decay = np.exp(-z)
-    safe = np.where(gamma > 0, gamma, 1.0)
-    gain = np.where(gamma > 0, -np.expm1(-z) / safe, c)
-    small = np.abs(z) < 1e-3
-    series = c * c * (0.5 - z / 6.0 + z * z / 24.0 - z ** 3 / 120.0)  # (z + expm1(-z)) c^2 / z^2 for small z
-    beyond = np.where(small, 1.0, safe)   # gamma where the closed form serves; 1 elsewhere, where gamma^2 may underflow
-    travel = np.where(small, series, (z + np.expm1(-z)) / (beyond * beyond))
+    # A backward kick (PEFRL's, Yoshida's) undoes drag: e^(gamma |c| h) may exceed the float range at a dt far
+    # above the stability bound. The factors are then inf, and a run forced there stops at its first check.
+    with np.errstate(over="ignore"):
+        decay = np.exp(-z)
+        safe = np.where(gamma > 0, gamma, 1.0)
+        gain = np.where(gamma > 0, -np.expm1(-z) / safe, c)
+        small = np.abs(z) < 1e-3
+        series = c * c * (0.5 - z / 6.0 + z * z / 24.0 - z ** 3 / 120.0)  # (z + expm1(-z)) c^2 / z^2, small z
+        beyond = np.where(small, 1.0, safe)   # gamma where the closed form serves; elsewhere gamma^2 may underflow
+        travel = np.where(small, series, (z + np.expm1(-z)) / (beyond * beyond))
     decay[:, held] = 1.0
     gain[:, held] = 0.0
     travel[:, held] = 0.0

@@ -1,13 +1,14 @@
 """Extreme cases: each ends in a correct result or a clean, named refusal or stop; never a hang or a silent NaN.
 
-k = 1e8; node mass 1e-4; N = 2; a loop of 3; N = 20,000; b = 0 and b = 1e4; dt at 0.9x and 1.1x of the bound;
-coincident nodes; g = 0; t_end = 0; t_end not a multiple of dt.
+k = 1e8; node mass 1e-4; N = 2; a loop of 3; N = 20,000; b = 0, b = 1e4 and b = 5e9 (backward kicks overflow);
+dt at 0.9x and 1.1x of the bound; coincident nodes; g = 0; t_end = 0; t_end not a multiple of dt.
 """
 
 from __future__ import annotations
 
 import math
 import textwrap
+import warnings
 
 import numpy as np
 import pytest
@@ -194,6 +195,23 @@ def test_no_drag_and_huge_drag():
         traj = ropesim.simulate(scene_from_toml(free, overrides=[f"integrator.method={method}"]))
         sane(traj)
         np.testing.assert_allclose(traj.v[-1, :, 1], -5.0 * 9.81 / 1e4, rtol=1e-6)
+
+
+@pytest.mark.parametrize("method", ["yoshida4", "pefrl"])
+def test_backward_kicks_under_drag_beyond_the_float_range(tmp_path, method):
+    """b = 5e9 kg/s: a backward kick's drag factor e^(gamma |c| h) overflows at dt = 1 ms. The bound says so (a
+    finite dt, not a traceback), the run is refused, and forced it stops at its first check without a warning."""
+    bound = predicted_dt(build(helicopter("drag.b=5e9")), method)
+    assert 0.0 < bound < 1e-6
+    args = ["run", str(HELICOPTER), "-q", "-o", str(tmp_path / "run")]
+    for s in ("drag.b=5e9", f"integrator.method={method}", "integrator.t_end=0.5"):
+        args += ["--set", s]
+    refused = runner.invoke(app, args, env=ENV)
+    assert refused.exit_code == 2 and "stability bound" in refused.stderr, refused.output
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        forced = runner.invoke(app, [*args, "--force"], env=ENV)
+    assert forced.exit_code == 3 and "blew up at t =" in forced.stderr, (forced.output, forced.exception)
 
 
 @pytest.mark.parametrize("method", ["symplectic_euler", "verlet", "yoshida4", "pefrl", "rk4"])

@@ -21,6 +21,7 @@ from ropesim import scene as S
 from ropesim.build import build
 from ropesim.loader import SceneError, apply_override, load_scene, parse_override, scene_from_toml
 from ropesim.analysis.stability import time_step_verdict
+from ropesim.integrators import METHODS
 from ropesim.run import BLEW_UP, COMPLETED, Stepper, TimeGrid, simulate
 
 from conftest import ROOT, SCENARIOS
@@ -549,9 +550,12 @@ SCALES = [-1.0, 0.0, 1e-12, 1e-9, 1e-3, 0.1, 10.0, 1e3, 1e9, 1e12]
 
 @st.composite
 def rescaled_scenes(draw):
-    """A valid scene with one to three of its numbers scaled by 0, -1 or 10^-12 ... 10^12 (counts: -3 to 60)."""
-    return _numbers_changed(draw, lambda draw, old: draw(st.integers(-3, 60)) if isinstance(old, int)
-                            else old * draw(st.sampled_from(SCALES)))
+    """A valid scene with one to three of its numbers scaled by 0, -1 or 10^-12 ... 10^12 (counts: -3 to 60),
+    run by any of the integrators."""
+    raw = _numbers_changed(draw, lambda draw, old: draw(st.integers(-3, 60)) if isinstance(old, int)
+                           else old * draw(st.sampled_from(SCALES)))
+    raw.setdefault("integrator", {})["method"] = draw(st.sampled_from(sorted(METHODS)))
+    return raw
 
 
 @st.composite
