@@ -42,6 +42,20 @@ LOOP = {
     "guides": [{"center": [-1.0, 0.0], "radius": 0.5}, {"center": [1.0, 0.0], "radius": 0.5}],
     "integrator": {"dt": 0.001, "t_end": 0.1},
 }
+TOWED_3D = {   # a towed rope with an end mass, in 3-D
+    "dimension": 3,
+    "rope": {"nodes": 12, "segment_length": 0.5, "stiffness": 5000.0, "mass": 5.0},
+    "initial": {"shape": "hanging", "top": [0.0, 0.0, 0.0], "velocity": [8.0, 0.0, 1.0]},
+    "driven": [{"nodes": [0], "velocity": [8.0, 0.0, 1.0]}],
+    "gravity": {"g": 9.81},
+    "drag": {"b": 5.0},
+    "overrides": [{"index": -1, "mass": 100.0}],
+    "integrator": {"dt": 0.001, "t_end": 0.1},
+}
+SHOOTER_3D = {**LOOP, "dimension": 3, "thrower": {**LOOP["thrower"], "center": [0.0, 0.0, 0.0]},
+              "guides": [{"center": [-1.0, 0.0, 0.0], "radius": 0.5}, {"center": [1.0, 0.0, 0.0], "radius": 0.5}],
+              "initial": {"shape": "square_loop", "velocity": [0.0, 0.0, 0.5]}, "bending": {"stiffness": 10.0},
+              "drag": {"b": 0.1}, "gravity": {"g": 9.81}}
 DELETE = object()
 
 
@@ -498,7 +512,12 @@ def test_round_trip_of_the_shapes_not_in_scenarios():
 
 # ------------------------------------------------------------------------------ property-based tests
 
-VALID_RAWS = [tomllib.loads(p.read_text()) for p in SCENARIO_FILES] + [LINE, LOOP]
+VALID_RAWS = [tomllib.loads(p.read_text()) for p in SCENARIO_FILES] + [LINE, LOOP, TOWED_3D, SHOOTER_3D]
+
+
+def test_the_fuzz_tests_start_from_valid_scenes():
+    for raw in VALID_RAWS:
+        assert load(raw) is not None
 KEY_WORDS = sorted({*S.TOP_LEVEL_SCALARS, *S.TABLES, *S.ARRAYS_OF_TABLES, "shape",
                     *(f.name for cls in [*S.TABLES.values(), *S.ARRAYS_OF_TABLES.values(), *S.INITIAL_SHAPES.values()]
                       if cls is not None for f in fields(cls))})
