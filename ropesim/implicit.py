@@ -240,11 +240,10 @@ def _spring_blocks(x, band, corner, n, dim, w, k, rest, stride, closed, scale, f
             continue
         r = math.sqrt(r2)
         geo = max(0.0, 1.0 - rest / r)   # compressive (negative) geometric stiffness left out: SPD
+        u = ((x[0, j] - x[0, i]) / r, (x[1, j] - x[1, i]) / r, (x[2, j] - x[2, i]) / r if dim == 3 else 0.0)
         for a in range(dim):
-            ua = (x[a, j] - x[a, i]) / r
             for b in range(dim):
-                ub = (x[b, j] - x[b, i]) / r
-                blk[a, b] = scale * k * ((1.0 - geo) * ua * ub + (geo if a == b else 0.0))
+                blk[a, b] = scale * k * ((1.0 - geo) * u[a] * u[b] + (geo if a == b else 0.0))
         _add_pair(band, corner, n, dim, w, i, j, blk, free[i], free[j])
 
 
