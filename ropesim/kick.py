@@ -21,10 +21,9 @@ SCRATCH_NODES = 256   # from this many nodes kick_drift sums each node's loss ov
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _lanes(t):
-    """Sum of ``t`` as four running sums combined in a fixed order."""
+def _add_lanes(t, s0, s1, s2, s3):
+    """The four running sums (s0, s1, s2, s3) with ``t`` added: term i to sum i % 4, the tail to s0."""
     n = t.shape[0]
-    s0 = s1 = s2 = s3 = 0.0
     whole = n - n % LANES
     for i in range(0, whole, LANES):
         s0 += t[i]
@@ -33,6 +32,13 @@ def _lanes(t):
         s3 += t[i + 3]
     for i in range(whole, n):
         s0 += t[i]
+    return s0, s1, s2, s3
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _lanes(t):
+    """Sum of ``t`` as four running sums combined in a fixed order."""
+    s0, s1, s2, s3 = _add_lanes(t, 0.0, 0.0, 0.0, 0.0)
     return (s0 + s1) + (s2 + s3)
 
 
@@ -92,7 +98,6 @@ def kick_drift(x, v, acc, decay, gain, travel, k, mass, c, buf):
             buf[i] *= mass[i]
         return _lanes(buf)
     s0 = s1 = s2 = s3 = 0.0
-    whole = n - n % LANES
     for d in range(dim):   # buf holds one row's terms
         if c != 0.0:
             for i in range(n):
@@ -109,11 +114,5 @@ def kick_drift(x, v, acc, decay, gain, travel, k, mass, c, buf):
                 vn = decay[k, i] * vo + gain[k, i] * a
                 buf[i] = mass[i] * (a * (gain[k, i] * vo + travel[k, i] * a) - 0.5 * (vn * vn - vo * vo))
                 v[d, i] = vn
-        for i in range(0, whole, LANES):
-            s0 += buf[i]
-            s1 += buf[i + 1]
-            s2 += buf[i + 2]
-            s3 += buf[i + 3]
-        for i in range(whole, n):
-            s0 += buf[i]
+        s0, s1, s2, s3 = _add_lanes(buf, s0, s1, s2, s3)
     return (s0 + s1) + (s2 + s3)
