@@ -1,0 +1,133 @@
+"""Refactors change no numbers: short runs of every built-in scene (and a few more) under every integrator
+reproduce, bit for bit, the frames, ledgers and step counts recorded before the integration layer was
+restructured (commit 65782d3, recorded with ``python tests/test_bit_identity.py --record``).
+
+Re-record only for a deliberate change of the numbers, and say so in the commit message.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import tomli_w
+
+HERE = Path(__file__).resolve().parent
+DATA = HERE / "data" / "bit_identity"
+SCENARIOS = HERE.parent / "scenarios"
+METHODS = ("symplectic_euler", "verlet", "yoshida4", "pefrl", "rk4", "sdirk2")
+SHORT = ["integrator.t_end=0.3", "output.interval=0.05"]
+
+EXTRA = {   # 3-D, a held and overridden 3-D towed rope, a 3-D shooter with bending, a plain 2-D loop
+    "towed_3d": {
+        "dimension": 3,
+        "rope": {"nodes": 12, "segment_length": 0.5, "stiffness": 5000.0, "mass": 5.0},
+        "initial": {"shape": "hanging", "top": [0.0, 0.0, 0.0], "velocity": [8.0, 0.0, 1.0]},
+        "driven": [{"nodes": [0], "velocity": [8.0, 0.0, 1.0]}],
+        "gravity": {"g": 9.81}, "drag": {"b": 5.0},
+        "overrides": [{"index": -1, "mass": 100.0, "drag": 30.0}],
+        "integrator": {"dt": 0.001, "t_end": 0.3}, "output": {"interval": 0.05},
+    },
+    "shooter_3d": {
+        "dimension": 3,
+        "rope": {"nodes": 8, "segment_length": 1.0, "stiffness": 100.0, "mass": 1.0, "closed": True},
+        "initial": {"shape": "square_loop", "velocity": [0.0, 0.0, 0.5]},
+        "thrower": {"center": [0.0, 0.0, 0.0], "length": 2.0, "width": 1.0, "v_max": 1.0, "b_thrower": 5.0},
+        "guides": [{"center": [-1.0, 0.0, 0.0], "radius": 0.5}, {"center": [1.0, 0.0, 0.0], "radius": 0.5}],
+        "bending": {"stiffness": 10.0}, "drag": {"b": 0.1}, "gravity": {"g": 9.81},
+        "integrator": {"dt": 0.001, "t_end": 0.3}, "output": {"interval": 0.05},
+    },
+    "plain_loop": {
+        "rope": {"nodes": 16, "segment_length": 0.4, "stiffness": 800.0, "mass": 0.2, "closed": True},
+        "initial": {"shape": "points", "velocity": [0.5, 1.0],
+                    "points": [[float(np.cos(2 * np.pi * i / 16)), float(np.sin(2 * np.pi * i / 16))]
+                               for i in range(16)]},
+        "pinned": {"nodes": [3]},
+        "gravity": {"g": 9.81}, "drag": {"b": 0.05},
+        "overrides": [{"index": 7, "mass": 0.5}],
+        "integrator": {"dt": 0.001, "t_end": 0.3}, "output": {"interval": 0.05},
+    },
+}
+SMOOTH = ["thrower.edge_width=0.2", "guides.0.edge_width=0.2", "guides.1.edge_width=0.2"]
+
+
+def scenes() -> dict:
+    """Every case's scene, by name."""
+    import ropesim
+
+    out = {f.stem: ropesim.load_scene(f, SHORT) for f in sorted(SCENARIOS.glob("*.toml"))}
+    out["shooter_medium_smooth"] = ropesim.load_scene(SCENARIOS / "shooter_medium.toml", SHORT + SMOOTH)
+    for name, raw in EXTRA.items():
+        out[name] = ropesim.scene_from_toml(tomli_w.dumps(raw), source=name, default_name=name)
+    return out
+
+
+def with_method(scene, method: str):
+    return dataclasses.replace(scene, integrator=dataclasses.replace(scene.integrator, method=method))
+
+
+def run_case(scene) -> dict:
+    """Frames (t, x, v), the ledger per frame, status, steps and force evaluations of one run, in memory."""
+    from ropesim.build import build
+    from ropesim.run import TimeGrid, integrate
+    from ropesim.trajectory import FrameStore
+
+    model = build(scene)
+    store = FrameStore(TimeGrid.of(scene).frames, model.nodes, model.dim, None)
+    outcome = integrate(model, store)
+    arrays = store.arrays()
+    return {"t": np.array(arrays["t"]), "x": np.array(arrays["x"]), "v": np.array(arrays["v"]),
+            "ledger": np.array(outcome.ledger), "status": outcome.status, "steps": outcome.steps,
+            "force_evaluations": outcome.force_evaluations}
+
+
+CASES = [(name, method) for name in [p.stem for p in sorted(SCENARIOS.glob("*.toml"))]
+         + ["shooter_medium_smooth", *EXTRA] for method in METHODS]
+
+
+@pytest.fixture(scope="module")
+def all_scenes():
+    return scenes()
+
+
+@pytest.fixture(scope="module")
+def index():
+    return json.loads((DATA / "index.json").read_text())
+
+
+@pytest.mark.parametrize("name,method", CASES, ids=[f"{n}-{m}" for n, m in CASES])
+def test_reproduces_recorded_run_bit_for_bit(all_scenes, index, name, method):
+    key = f"{name}__{method}"
+    got = run_case(with_method(all_scenes[name], method))
+    want = index[key]
+    assert (got["status"], got["steps"], got["force_evaluations"]) == (
+        want["status"], want["steps"], want["force_evaluations"])
+    with np.load(DATA / f"{key}.npz") as rec:
+        for array in ("t", "x", "v", "ledger"):
+            assert got[array].shape == rec[array].shape, array
+            assert np.array_equal(got[array], rec[array]), f"{array} differs (largest difference " \
+                f"{np.max(np.abs(got[array] - rec[array]))})"
+
+
+def record() -> None:
+    DATA.mkdir(parents=True, exist_ok=True)
+    index = {}
+    cases = scenes()
+    for name, method in CASES:
+        got = run_case(with_method(cases[name], method))
+        key = f"{name}__{method}"
+        np.savez_compressed(DATA / f"{key}.npz", **{a: got[a] for a in ("t", "x", "v", "ledger")})
+        index[key] = {k: got[k] for k in ("status", "steps", "force_evaluations")}
+        print(key, got["status"], got["steps"])
+    (DATA / "index.json").write_text(json.dumps(index, indent=1) + "\n")
+
+
+if __name__ == "__main__":
+    if sys.argv[1:] == ["--record"]:
+        record()
+    else:
+        print("usage: python tests/test_bit_identity.py --record")
