@@ -11,7 +11,7 @@ Heavy modules (numba, matplotlib) load only when first used, so the command line
 
 __version__ = "0.1.0"
 
-from .numba_cache import ensure_writable_cache  # noqa: E402
+from .io.numba_cache import ensure_writable_cache  # noqa: E402
 
 ensure_writable_cache()  # before any kernel is defined: a read-only install caches its kernels elsewhere
 
@@ -19,11 +19,11 @@ __all__ = ["load_scene", "scene_from_toml", "SceneError", "Scene", "simulate", "
            "METHODS", "scene_to_toml"]
 
 _LAZY = {
-    "load_scene": "loader", "scene_from_toml": "loader", "SceneError": "loader",
-    "Scene": "scene", "scene_to_toml": "scene",
+    "load_scene": "scene.loader", "scene_from_toml": "scene.loader", "SceneError": "scene.loader",
+    "Scene": "scene.schema", "scene_to_toml": "scene.schema",
     "simulate": "run",
-    "Trajectory": "trajectory", "RunFolderError": "trajectory",
-    "METHODS": "integrators",
+    "Trajectory": "io.trajectory", "RunFolderError": "io.trajectory",
+    "METHODS": "integrate.splitting",
 }
 
 

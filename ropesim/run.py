@@ -18,10 +18,10 @@ from typing import Callable
 
 import numpy as np
 
-from .build import Model, build
-from .health import NEWTON_FAILED, NON_FINITE, OK, OVERSTRETCH, RUNAWAY_ENERGY
-from .integrators import advance, get_method, kick_factors
-from .scene import Scene
+from .model.build import Model, build
+from .integrate.health import NEWTON_FAILED, NON_FINITE, OK, OVERSTRETCH, RUNAWAY_ENERGY
+from .integrate.splitting import advance, get_method, kick_factors
+from .scene.schema import Scene
 
 COMPLETED, INTERRUPTED, BLEW_UP = "completed", "interrupted", "blew_up"
 CHECK_EVERY = 64  # steps between finiteness checks: a blow-up is caught within this many steps
@@ -73,7 +73,7 @@ class Stepper:
     def __init__(self, model: Model, method: str, grid: TimeGrid, specialise: bool = True):
         """``specialise=False`` keeps a plain spring rope off the fast path of :mod:`ropesim.chain` (for tests)."""
         from .analysis.energy import energy_terms
-        from .health import E0, LEDGER_SIZE, SCALE
+        from .integrate.health import E0, LEDGER_SIZE, SCALE
 
         self.model, self.grid = model, grid
         self.scheme = get_method(method)
@@ -102,7 +102,7 @@ class Stepper:
             self.exact_contacts = smooth_contacts(model)  # exact kicks for nodes touching the box or a circle
             self.contact_scratch = (np.ascontiguousarray(~model.held), np.where(model.held, 0.0, model.drag / model.mass),
                                     np.zeros_like(self.x), np.zeros(model.nodes, dtype=np.int64))
-            from . import chain
+            from .integrate import chain
 
             self.chain = (chain.ChainState(model, self.decay, self.gain, self.travel)
                           if specialise and chain.applies(model, self.scheme) else None)
@@ -114,7 +114,7 @@ class Stepper:
             self.kv = np.zeros((stages,) + self.x.shape)
             self.gamma = np.where(model.held, 0.0, model.drag / model.mass)
         else:
-            from .implicit import NEWTON_TOL, band_width, scratch
+            from .integrate.sdirk import NEWTON_TOL, band_width, scratch
 
             scene = model.scene
             bending = scene.bending is not None
@@ -147,7 +147,7 @@ class Stepper:
 
     def new_frames(self, n: int) -> tuple:
         """Empty frame buffers (t, x, v, ledger) for the next ``n`` steps."""
-        from .health import LEDGER_COLUMNS
+        from .integrate.health import LEDGER_COLUMNS
 
         k = self.frames_in(n)
         dim, nodes = self.x.shape
@@ -160,7 +160,7 @@ class Stepper:
         m, g = self.model, self.grid
         kind = self.scheme.kind
         if kind == "splitting" and self.chain is not None:
-            from .chain import advance_chain
+            from .integrate.chain import advance_chain
 
             c = self.chain
             done, written, status, node = advance_chain(
@@ -174,7 +174,7 @@ class Stepper:
                 self.drift, self.kick, self.decay, self.gain, self.travel, self.reuse_force, self.held, m.mass,
                 m.forces, self.limits, g.save_every, frames, CHECK_EVERY, (self.exact_contacts, *self.contact_scratch))
         elif kind == "rk":
-            from .rk import advance_rk
+            from .integrate.rk import advance_rk
 
             a, b, c = self.tables
             done, written, status, node = advance_rk(
@@ -182,7 +182,7 @@ class Stepper:
                 n, g.steps, g.dt, a, b, c, self.gamma, self.held, m.mass, m.forces, self.limits, g.save_every,
                 frames, CHECK_EVERY)
         else:
-            from .implicit import advance_sdirk
+            from .integrate.sdirk import advance_sdirk
 
             done, written, status, node = advance_sdirk(
                 self.x, self.v, self.acc, self.acc_box, self.ledger, self.stats, self.step, n, g.steps, g.dt,
@@ -229,7 +229,7 @@ def stretch_limit(model: Model) -> float:
     the longest spring at t = 0, whichever is largest. Stable runs of the built-in scenes stay below 1.7; an
     unstable one that saturates instead of overflowing (bounded garbage) goes past it within a few steps.
     """
-    from .forces.springs import pair_spring_stretch
+    from .model.forces.springs import pair_spring_stretch
 
     scene, rope = model.scene, model.scene.rope
     g = scene.gravity.g if scene.gravity is not None else 0.0
@@ -316,7 +316,7 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
     stable_dt = None
     if status == BLEW_UP:
         stable_dt, message = _blow_up_message(model, stepper, code, bad_node)
-    from .health import E0
+    from .integrate.health import E0
 
     return RunOutcome(status=status, steps=stepper.step, t_reached=stepper.t, wall_time=wall,
                       compile_time=compile_time, grid=grid, message=message, bad_node=bad_node, stable_dt=stable_dt,
@@ -369,8 +369,8 @@ def simulate(scene: Scene, folder: str | Path | None = None, progress: bool = Fa
     """
     from .analysis.ledger import write_ledger
     from .analysis.summary import summarize
-    from .scene import scene_to_toml
-    from .trajectory import SCENE, SUMMARY, FrameStore, Trajectory, write_json_atomic, write_text_atomic
+    from .scene.schema import scene_to_toml
+    from .io.trajectory import SCENE, SUMMARY, FrameStore, Trajectory, write_json_atomic, write_text_atomic
 
     model = build(scene)
     grid = TimeGrid.of(scene)

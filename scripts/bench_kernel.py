@@ -144,7 +144,7 @@ def same_physics(n: int, steps: int) -> float:
 
 def method_rates(sizes: list[int], work: float, repeats: int) -> dict:
     """Median node-steps per second of every integrator at every size."""
-    from ropesim.integrators import METHODS
+    from ropesim.integrate.splitting import METHODS
 
     out = {}
     for name, method in METHODS.items():
@@ -160,7 +160,7 @@ def method_rates(sizes: list[int], work: float, repeats: int) -> dict:
 def shooter_step_times(repeats: int) -> dict:
     """Median wall time [s] of one step of every integrator on scenarios/shooter_high.toml."""
     import ropesim
-    from ropesim.integrators import METHODS
+    from ropesim.integrate.splitting import METHODS
 
     out = {}
     for name, method in METHODS.items():
@@ -203,7 +203,7 @@ def main() -> None:
     table.add_column("method")
     for n in sizes:
         table.add_column(f"N = {n:,}", justify="right")
-    from ropesim.integrators import METHODS
+    from ropesim.integrate.splitting import METHODS
 
     for name in METHODS:
         table.add_row(name, *(rate(rates[name, n], 1) for n in sizes))

@@ -42,7 +42,7 @@ def contenders(n: int, steps: int) -> dict:
         done[0] += steps
 
     out["yardstick"] = yard
-    from ropesim.chain import advance_chain
+    from ropesim.integrate.chain import advance_chain
 
     for name, check_every, work in (("ropesim as run", 64, True), ("no blow-up check", NEVER, True),
                                     ("no check, no work term", NEVER, False)):

@@ -50,7 +50,7 @@ def fixed_rope(n: int, method: str, dt: float | None):
                 f"drag.b={DRAG_PER_M * LENGTH / n!r}"]
     if dt is None:
         from ropesim.analysis.stability import predicted_dt
-        from ropesim.build import build
+        from ropesim.model.build import build
 
         probe = towed_scene(n, method, 1, extra=material)
         dt = 0.9 * predicted_dt(build(probe), method)

@@ -11,7 +11,7 @@ process is stretched by whoever else is running, its CPU time much less.
 With --installed it also builds a throwaway virtual environment, installs the project into it normally
 (not editable) with pip, makes the installed package read-only (a read-only bind mount when run as root,
 else the write bits removed) and checks that the compile cache still works: the first run compiles and
-writes its cache outside the package (see ropesim/numba_cache.py), the second loads it. NUMBA_CACHE_DIR is
+writes its cache outside the package (see ropesim/io/numba_cache.py), the second loads it. NUMBA_CACHE_DIR is
 unset there, as for a user; HOME is a fresh folder, and once a folder that cannot be written.
 
     python scripts/bench_startup.py [--repeats 7] [--installed]

@@ -11,8 +11,8 @@ from __future__ import annotations
 import textwrap
 import time
 
-from ropesim.build import build
-from ropesim.loader import scene_from_toml
+from ropesim.model.build import build
+from ropesim.scene.loader import scene_from_toml
 from ropesim.run import Stepper, TimeGrid
 
 

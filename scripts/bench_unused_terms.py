@@ -20,7 +20,7 @@ from rich.console import Console
 from rich.table import Table
 
 import ropesim
-from ropesim.build import build
+from ropesim.model.build import build
 from ropesim.run import Stepper, TimeGrid
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -34,7 +34,7 @@ def towed_scene(nodes: int, method: str = "symplectic_euler", steps: int = 1000,
 
 def stepper_for(scene):
     """A warmed-up :class:`ropesim.run.Stepper` for ``scene`` (kernel compiled or loaded from cache)."""
-    from ropesim.build import build
+    from ropesim.model.build import build
     from ropesim.run import Stepper, TimeGrid
 
     stepper = Stepper(build(scene), scene.integrator.method, TimeGrid.of(scene))

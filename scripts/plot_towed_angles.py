@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ropesim.build import build
-from ropesim.trajectory import RunFolderError, Trajectory
+from ropesim.model.build import build
+from ropesim.io.trajectory import RunFolderError, Trajectory
 from ropesim.analysis.towed import exact_steady_state, segment_angles, towed_end
 
 WRITE_UP_T_END = 3.0  # s: the write-up's t_f for the helicopter

@@ -21,11 +21,11 @@ from typer.testing import CliRunner
 
 import ropesim
 from ropesim.analysis.accuracy import accuracy_report, observed_order, run_once
-from ropesim.build import build
-from ropesim.cli import app
-from ropesim.integrators import METHODS
-from ropesim.loader import scene_from_toml
-from ropesim.scene import Integrator
+from ropesim.model.build import build
+from ropesim.cli.app import app
+from ropesim.integrate.splitting import METHODS
+from ropesim.scene.loader import scene_from_toml
+from ropesim.scene.schema import Integrator
 
 from conftest import SCENARIOS
 
@@ -267,8 +267,8 @@ def test_exact_contact_kicks_restore_the_splitting_schemes_orders_on_the_smoothe
 def test_exact_contact_kick_solves_the_linear_kick_equation():
     """One node in the box and a circle's overlap, frozen x: the exact kick equals a fine RK4 integration of
     v' = a(x, v) - gamma v (a linear in v) over the kick, also for a negative (backward) kick."""
-    from ropesim.contact import exact_contact_kicks
-    from ropesim.kernel import accelerations
+    from ropesim.integrate.contact import exact_contact_kicks
+    from ropesim.model.terms import accelerations
 
     model = build(shooter())
     x = model.x0.copy()
@@ -301,7 +301,7 @@ def test_exact_contact_kick_solves_the_linear_kick_equation():
 
 
 def test_smooth_step_and_box_weight():
-    from ropesim.forces.thrower import box_weight, smooth_step
+    from ropesim.model.forces.thrower import box_weight, smooth_step
 
     assert smooth_step(0.0, 0.1) == 0.5 and smooth_step(1e-9, 0.0) == 1.0 and smooth_step(0.0, 0.0) == 0.0
     assert smooth_step(2.0, 0.1) == 1.0 and smooth_step(-2.0, 0.1) == 0.0  # exactly, beyond 20 widths
@@ -320,8 +320,8 @@ def test_banded_newton_solver_matches_a_dense_solve(n, dim, bending, closed, see
     """The stiff integrator's linear solver (banded Cholesky, Woodbury correction for a loop's wrap-around)
     solves a random positive definite rope matrix, with springs between neighbours and second neighbours, as
     a dense solve does, to round-off."""
-    from ropesim.build import spring_count
-    from ropesim.implicit import _add_pair, _factor, _solve, band_width, scratch
+    from ropesim.model.build import spring_count
+    from ropesim.integrate.sdirk import _add_pair, _factor, _solve, band_width, scratch
 
     if closed and bending and n < 5:
         return  # the loader refuses bending on loops of fewer than 5 nodes

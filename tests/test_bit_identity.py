@@ -72,9 +72,9 @@ def with_method(scene, method: str):
 
 def run_case(scene) -> dict:
     """Frames (t, x, v), the ledger per frame, status, steps and force evaluations of one run, in memory."""
-    from ropesim.build import build
+    from ropesim.model.build import build
     from ropesim.run import TimeGrid, integrate
-    from ropesim.trajectory import FrameStore
+    from ropesim.io.trajectory import FrameStore
 
     model = build(scene)
     store = FrameStore(TimeGrid.of(scene).frames, model.nodes, model.dim, None)

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import ropesim
-from ropesim import chain
-from ropesim.build import build
-from ropesim.health import DRAG, HELD
-from ropesim.integrators import METHODS
+from ropesim.integrate import chain
+from ropesim.model.build import build
+from ropesim.integrate.health import DRAG, HELD
+from ropesim.integrate.splitting import METHODS
 from ropesim.run import Stepper, TimeGrid
 
 SPLITTING = [name for name, m in METHODS.items() if m.kind == "splitting"]
@@ -148,7 +148,7 @@ def test_a_blow_up_on_the_fast_path_is_caught_and_named(scenarios):
 @pytest.mark.parametrize("closed", [False, True])
 def test_the_fast_check_measures_what_the_general_one_does(tmp_path, closed):
     """Energy to round-off, and the same worst spring, as ropesim.kernel.mechanical_energy; NaN stays NaN."""
-    from ropesim.kernel import mechanical_energy
+    from ropesim.model.terms import mechanical_energy
 
     text = LOOP if closed else LOOP.replace("closed = true", "closed = false").replace(
         'shape = "square_loop"\ntop_center = [0.0, 0.0]', 'shape = "line"\nstart = [0.0, 0.0]\nend = [1.1, -0.3]')

@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from ropesim.build import build
-from ropesim.cli import app
-from ropesim.integrators import METHODS
-from ropesim.loader import load_scene
+from ropesim.model.build import build
+from ropesim.cli.app import app
+from ropesim.integrate.splitting import METHODS
+from ropesim.scene.loader import load_scene
 
 from conftest import ROOT, SCENARIOS
 

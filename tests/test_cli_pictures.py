@@ -12,7 +12,7 @@ import pytest
 from PIL import Image
 from typer.testing import CliRunner
 
-from ropesim.cli import app
+from ropesim.cli.app import app
 
 from conftest import ROOT, SCENARIOS
 

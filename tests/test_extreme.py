@@ -16,10 +16,10 @@ from typer.testing import CliRunner
 
 import ropesim
 from ropesim.analysis.stability import predicted_dt
-from ropesim.build import build
-from ropesim.cli import app
-from ropesim.integrators import METHODS
-from ropesim.loader import scene_from_toml
+from ropesim.model.build import build
+from ropesim.cli.app import app
+from ropesim.integrate.splitting import METHODS
+from ropesim.scene.loader import scene_from_toml
 
 from conftest import SCENARIOS
 

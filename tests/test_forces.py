@@ -9,9 +9,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ropesim.build import build
-from ropesim.kernel import accelerations
-from ropesim.loader import scene_from_dict
+from ropesim.model.build import build
+from ropesim.model.terms import accelerations
+from ropesim.scene.loader import scene_from_dict
 
 
 def scene_dict(n, closed, dim, bending=None, gravity=None, k=5000.0, l=0.5):
@@ -161,8 +161,8 @@ def shooter_model(**thrower):
 
 def single_node_acc(model, pos, vel):
     """Acceleration of node 0 at ``pos``/``vel`` with the springs switched off (k -> 0 via a far-away rope)."""
-    from ropesim.forces.guides import add_guides
-    from ropesim.forces.thrower import add_thrower
+    from ropesim.model.forces.guides import add_guides
+    from ropesim.model.forces.thrower import add_thrower
 
     x = np.array(pos, dtype=float).reshape(2, 1)
     v = np.array(vel, dtype=float).reshape(2, 1)

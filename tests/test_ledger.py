@@ -13,9 +13,9 @@ from hypothesis import strategies as st
 
 import ropesim
 from ropesim.analysis.ledger import LEDGER, ledger_series, read_flows
-from ropesim.build import build
-from ropesim.integrators import METHODS, kick_factors
-from ropesim.loader import scene_from_toml
+from ropesim.model.build import build
+from ropesim.integrate.splitting import METHODS, kick_factors
+from ropesim.scene.loader import scene_from_toml
 from ropesim.run import Stepper, TimeGrid
 
 from conftest import SCENARIOS
@@ -145,7 +145,7 @@ def test_ledger_is_identical_however_the_run_is_chunked():
 def test_plot_shows_the_ledger(tmp_path):
     from typer.testing import CliRunner
 
-    from ropesim.cli import app
+    from ropesim.cli.app import app
 
     scene = ropesim.load_scene(SCENARIOS / "helicopter_uniform.toml", ["integrator.t_end=0.5"])
     ropesim.simulate(scene, tmp_path / "run")

@@ -17,11 +17,11 @@ import tomli_w
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from ropesim import scene as S
-from ropesim.build import build
-from ropesim.loader import SceneError, apply_override, load_scene, parse_override, scene_from_toml
+from ropesim.scene import schema as S
+from ropesim.model.build import build
+from ropesim.scene.loader import SceneError, apply_override, load_scene, parse_override, scene_from_toml
 from ropesim.analysis.stability import time_step_verdict
-from ropesim.integrators import METHODS
+from ropesim.integrate.splitting import METHODS
 from ropesim.run import BLEW_UP, COMPLETED, Stepper, TimeGrid, simulate
 
 from conftest import ROOT, SCENARIOS

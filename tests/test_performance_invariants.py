@@ -2,7 +2,7 @@
 
 - The compile cache: a kernel compiled in one process loads from the cache in the next, an edit to any
   module starts a fresh cache folder, and an install whose package folder cannot be written still gets a
-  writable cache folder (ropesim/numba_cache.py).
+  writable cache folder (ropesim/io/numba_cache.py).
 - Memory: a run folder's frames stream to disk, so the memory a run allocates does not grow with the
   number of saved frames (counted with tracemalloc, which sees NumPy's allocations).
 - Parallel kernels give bit-identical results to the serial ones.
@@ -23,7 +23,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import ropesim
-from ropesim import numba_cache
+from ropesim.io import numba_cache
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -108,7 +108,7 @@ def test_ensure_writable_cache_tells_an_already_imported_numba(tmp_path, monkeyp
 PROBE = """
 import json, sys
 import ropesim
-from ropesim.chain import advance_chain as advance   # the towed rope's kernel (the general one's is alike)
+from ropesim.integrate.chain import advance_chain as advance   # the towed rope's kernel (the general one's is alike)
 scene = ropesim.load_scene(sys.argv[1], ["integrator.t_end=0.05"])
 ropesim.simulate(scene)
 stats = advance.stats
@@ -127,7 +127,7 @@ def test_a_compiled_kernel_loads_from_the_cache_in_a_fresh_process(scenarios):
 
 @pytest.mark.parametrize("shape", [(7, 40, 2), (3, 5, 33, 3), (40, 2), (1, 9, 2)])
 def test_spring_helpers_give_the_same_numbers_block_by_block(shape, monkeypatch):
-    from ropesim.forces import springs
+    from ropesim.model.forces import springs
 
     x = np.random.default_rng(len(shape)).normal(size=shape)
     whole = [springs.pair_spring_energy(x, 3.0, 0.5, 1, True), springs.pair_spring_stretch(x, 0.5, 2, False)]
@@ -156,7 +156,7 @@ def test_a_run_folder_does_not_hold_its_frames_in_memory(scenarios, tmp_path, mo
     """
     from ropesim import run as run_module
     from ropesim.analysis import summary
-    from ropesim.forces import springs
+    from ropesim.model.forces import springs
 
     for module, name in ((run_module, "FRAME_BUFFER_BYTES"), (summary, "BLOCK_BYTES"), (springs, "BLOCK_BYTES")):
         monkeypatch.setattr(module, name, 256 * 1024)
@@ -178,7 +178,7 @@ def test_a_run_folder_does_not_hold_its_frames_in_memory(scenarios, tmp_path, mo
 @given(dim=st.sampled_from([2, 3]), n=st.integers(1, 40), closed=st.booleans(), seed=st.integers(0, 2 ** 31))
 def test_vectorised_chain_springs_equal_the_pairwise_springs(dim, n, closed, seed):
     """set_chain_springs (two vectorised passes, gravity included) = add_pair_springs(stride 1) + gravity."""
-    from ropesim.forces.springs import add_pair_springs, set_chain_springs
+    from ropesim.model.forces.springs import add_pair_springs, set_chain_springs
 
     rng = np.random.default_rng(seed)
     x = rng.normal(size=(dim, n))
@@ -202,7 +202,7 @@ def test_kick_bookkeeping_matches_the_plain_sums(n, seed, c):
     Both of kick_drift's paths (below and from SCRATCH_NODES nodes) and both of its row passes (with a drift,
     c != 0, and without) are exercised.
     """
-    from ropesim.kick import box_work, kick_drift
+    from ropesim.integrate.kick import box_work, kick_drift
 
     rng = np.random.default_rng(seed)
     x, v, acc, acc_box = (rng.normal(size=(2, n)) for _ in range(4))

@@ -17,7 +17,7 @@ from PIL import Image
 import ropesim
 from ropesim.analysis.energy import energy_terms
 from ropesim.analysis.summary import largest_stretch
-from ropesim.build import build
+from ropesim.model.build import build
 from ropesim.render import RenderError, framing
 from ropesim.render.animate import FrameRenderer, animate
 from ropesim.render.encode import gif_fps, gif_palette
@@ -27,7 +27,7 @@ from ropesim.render.framing import (Band, Box, Circle, fit_box, followed_nodes, 
 from ropesim.render.plots import largest_stretch_series, per_frame, plot_run
 from ropesim.render.scene_artist import ROPE_COLOR
 from ropesim.render.timeline import animation_plan, chosen_frames, parse_times
-from ropesim.trajectory import Trajectory
+from ropesim.io.trajectory import Trajectory
 
 from conftest import SCENARIOS
 

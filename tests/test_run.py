@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 import ropesim
-from ropesim.build import build
+from ropesim.model.build import build
 from ropesim.run import BLEW_UP, INTERRUPTED, Stepper, TimeGrid, integrate
-from ropesim.trajectory import FrameStore, Trajectory
+from ropesim.io.trajectory import FrameStore, Trajectory
 
 
 @pytest.mark.parametrize("name, method", [("helicopter_mass", "verlet"), ("shooter_low", "symplectic_euler"),

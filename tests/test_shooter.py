@@ -5,7 +5,7 @@ import pytest
 
 import ropesim
 from ropesim.analysis.shooter import circulation_speed, loop_inclination, nodes_in_thrower
-from ropesim.build import build
+from ropesim.model.build import build
 
 SCENES = ["shooter_vacuum", "shooter_low", "shooter_medium", "shooter_high"]
 

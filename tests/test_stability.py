@@ -14,10 +14,10 @@ from typer.testing import CliRunner
 import ropesim
 from ropesim.analysis.stability import (gershgorin_frequency, measured_dt, predicted_dt, spectral_frequency,
                                         stability_sweep)
-from ropesim.build import build
-from ropesim.cli import app
-from ropesim.integrators import METHODS, stable_step
-from ropesim.loader import scene_from_toml
+from ropesim.model.build import build
+from ropesim.cli.app import app
+from ropesim.integrate.splitting import METHODS, stable_step
+from ropesim.scene.loader import scene_from_toml
 
 from conftest import SCENARIOS
 

@@ -18,9 +18,9 @@ from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 import ropesim
-from ropesim.cli import app
-from ropesim.loader import parse_override
-from ropesim.sweep import (
+from ropesim.cli.app import app
+from ropesim.scene.loader import parse_override
+from ropesim.sweep.core import (
     TIMING_COLUMNS, Point, SweepError, parse_axis, plan, read_table, run_local, run_sweep, toml_value,
 )
 
@@ -272,7 +272,7 @@ def test_dask_cluster_gives_the_local_results_bit_for_bit(towed_sweep, tmp_path)
 
 def test_unreachable_scheduler_is_one_line(tmp_path, monkeypatch):
     pytest.importorskip("distributed", reason='the dask extra is not installed: pip install -e ".[dask]"')
-    from ropesim import sweep_dask
+    from ropesim.sweep import dask as sweep_dask
 
     monkeypatch.setattr(sweep_dask, "CONNECT_TIMEOUT", "1s")
     args = ["sweep", str(UNIFORM), "--out", str(tmp_path / "s"), "--set", "drag.b=1,2",

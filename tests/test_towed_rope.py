@@ -15,7 +15,7 @@ import scipy.special
 
 import ropesim
 from ropesim.analysis.towed import exact_steady_state, segment_angles, shape_verdict
-from ropesim.build import build
+from ropesim.model.build import build
 
 
 def final_shape(model, traj):

@@ -23,10 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..build import build
-from ..health import E0, OK, STATUS_NAMES
-from ..integrators import METHODS, get_method
-from ..scene import Scene
+from ..model.build import build
+from ..integrate.health import E0, OK, STATUS_NAMES
+from ..integrate.splitting import METHODS, get_method
+from ..scene.schema import Scene
 from .stability import predicted_dt
 
 REFERENCE_METHOD = "pefrl"
@@ -92,8 +92,8 @@ def run_once(scene: Scene, method: str, dt: float, repeats: int = 1, exact_conta
     ``exact_contacts`` overrides whether a splitting scheme kicks nodes touching the box or a circle exactly
     (see :mod:`ropesim.contact`; by default it does when their edges are smoothed).
     """
-    from ..analysis.energy import energy_terms
-    from ..health import BOX, DRAG, HELD
+    from .energy import energy_terms
+    from ..integrate.health import BOX, DRAG, HELD
     from ..run import Stepper, TimeGrid
 
     scene = single_frame(scene, dt, method)
@@ -175,7 +175,7 @@ def write_csv(report: Report, path) -> None:
     import csv
     import io
 
-    from ..trajectory import write_text_atomic
+    from ..io.trajectory import write_text_atomic
 
     buf = io.StringIO()
     w = csv.writer(buf)
@@ -193,7 +193,7 @@ def plot(report: Report, path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..atomic import atomic_output
+    from ..io.atomic import atomic_output
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), constrained_layout=True)
     for name in dict.fromkeys(r.method for r in report.rows):

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..build import Model
-from ..forces.springs import pair_spring_energy
+from ..model.build import Model
+from ..model.forces.springs import pair_spring_energy
 
 
 def energy_terms(model: Model, x: np.ndarray, v: np.ndarray) -> dict[str, np.ndarray]:

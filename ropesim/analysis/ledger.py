@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..build import Model
-from ..health import LEDGER_COLUMNS
+from ..model.build import Model
+from ..integrate.health import LEDGER_COLUMNS
 from .energy import energy_terms
 
 LEDGER = "ledger.npz"
@@ -30,7 +30,7 @@ FRAME_BLOCK = 256
 
 def write_ledger(folder: Path, t: np.ndarray, flows: np.ndarray, energy0: float) -> None:
     """Write ``ledger.npz`` atomically: the cumulative flows (F, 3) at the saved frames' times."""
-    from ..trajectory import write_npz_atomic
+    from ..io.trajectory import write_npz_atomic
 
     arrays = {"t": np.asarray(t)[:len(flows)]}
     arrays.update({name: np.ascontiguousarray(flows[:, c]) for c, name in enumerate(LEDGER_COLUMNS)})

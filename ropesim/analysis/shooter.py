@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..build import Model
+from ..model.build import Model
 
 AVERAGE_WINDOW_S = 1.0  # the mean inclination is over the last second (or the last 20 % of a shorter run)
 
@@ -47,7 +47,7 @@ def shooter_figures(model: Model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -
 
 def nodes_in_thrower(model: Model, x: np.ndarray) -> int:
     """How many nodes of one frame (N, D) are inside the thrower box: 0 means the loop has fallen out."""
-    from ..forces.thrower import inside_box
+    from ..model.forces.thrower import inside_box
 
     xdn = np.ascontiguousarray(np.asarray(x).T)
     box = model.forces[5]

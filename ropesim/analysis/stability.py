@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..build import Model, spring_count
-from ..integrators import METHODS, get_method, stable_step
+from ..model.build import Model, spring_count
+from ..integrate.splitting import METHODS, get_method, stable_step
 
 SPECTRAL_MAX_NODES = 800
 WARN_FRACTION = 0.8       # `ropesim run` warns above this fraction of the bound, refuses above the bound
@@ -199,8 +199,8 @@ def probe(scene, method: str, dt: float, steps: int = PROBE_STEPS) -> bool:
     """
     import dataclasses
 
-    from ..build import build
-    from ..health import BOX, DRAG, E0, HELD, OK, SCALE
+    from ..model.build import build
+    from ..integrate.health import BOX, DRAG, E0, HELD, OK, SCALE
     from ..run import Stepper, TimeGrid
     from .energy import energy_terms
 
@@ -267,7 +267,7 @@ def stability_sweep(scene, methods=None, fractions=None, stiffnesses=None, steps
     """
     import dataclasses
 
-    from ..build import build
+    from ..model.build import build
 
     methods = list(methods or METHODS)
     fractions = fractions or [round(0.1 * i, 2) for i in range(1, 21)]
@@ -298,7 +298,7 @@ def write_sweep(result: SweepResult, folder) -> tuple:
     import io
     from pathlib import Path
 
-    from ..trajectory import write_text_atomic
+    from ..io.trajectory import write_text_atomic
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -321,7 +321,7 @@ def plot_sweep(result: SweepResult, path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..atomic import atomic_output
+    from ..io.atomic import atomic_output
 
     methods = list(dict.fromkeys(r["method"] for r in result.rows))
     ks = sorted({r["stiffness"] for r in result.rows})

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from .. import __version__
-from ..build import Model
-from ..forces.springs import pair_spring_stretch
+from ..model.build import Model
+from ..model.forces.springs import pair_spring_stretch
 from .energy import energy_terms
 from .ledger import ledger_series, ledger_summary
 from .stability import predicted_dt

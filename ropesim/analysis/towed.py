@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..build import Model
-from ..scene import Scene
+from ..model.build import Model
+from ..scene.schema import Scene
 
 STRAIGHT_TOLERANCE_DEG = 1.0
 

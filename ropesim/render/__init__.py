@@ -3,8 +3,8 @@
 Pictures never re-run a scene: they read a run folder's saved frames (lazily, through
 :class:`ropesim.trajectory.Trajectory`) and the scene saved with them.
 
-    from ropesim.trajectory import Trajectory
-    from ropesim.render.animate import animate
+    from ..io.trajectory import Trajectory
+    from .animate import animate
     animate(Trajectory.open("runs/shooter_medium"), "shooter.gif", fps=25)
 
 Modules: ``timeline`` picks the saved frames to show, ``framing`` the projection and the fixed view limits,

@@ -14,12 +14,12 @@ from typing import Callable, Iterable, Iterator
 
 import numpy as np
 
-from ..build import Model, build
-from ..trajectory import Trajectory
+from ..model.build import Model, build
+from ..io.trajectory import Trajectory
 from . import RenderError
 from .encode import ANIMATION_TYPES, GIF_MAX_FPS, gif_fps, write_gif, write_mp4
 from .framing import Projection, figure_inches, followed_nodes, origin, projection, single_view, view_box
-from ..atomic import atomic_output
+from ..io.atomic import atomic_output
 from .output import output_type
 from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
 from .timeline import animation_plan

@@ -14,10 +14,10 @@ from pathlib import Path
 import numpy as np
 
 from . import RenderError
-from ..build import build
-from ..trajectory import Trajectory
+from ..model.build import build
+from ..io.trajectory import Trajectory
 from .framing import figure_inches, fit_box, followed_nodes, origin, projection, view_aspect, view_box
-from ..atomic import atomic_output
+from ..io.atomic import atomic_output
 from .output import output_type
 from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
 from .timeline import chosen_frames

@@ -15,7 +15,7 @@ import numpy as np
 
 from . import RenderError
 from ..analysis.summary import FRAME_BLOCK, block_frames
-from ..build import Model
+from ..model.build import Model
 
 AXIS_NAMES = "xyz"
 MAX_ASPECT = 3.0          # the view's height / width stays within [1 / MAX_ASPECT, MAX_ASPECT]

@@ -16,11 +16,11 @@ import numpy as np
 
 from ..analysis.energy import energy_terms
 from ..analysis.towed import exact_steady_state, segment_angles, shape_verdict, towed_end
-from ..build import Model, build
-from ..forces.springs import pair_spring_stretch
-from ..trajectory import Trajectory
+from ..model.build import Model, build
+from ..model.forces.springs import pair_spring_stretch
+from ..io.trajectory import Trajectory
 from .framing import figure_inches, frame_blocks
-from ..atomic import atomic_output
+from ..io.atomic import atomic_output
 from .output import output_type
 
 DPI = 100

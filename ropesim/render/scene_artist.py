@@ -16,7 +16,7 @@ from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Rectangle
 from matplotlib.transforms import Affine2D
 
-from ..build import Model
+from ..model.build import Model
 from .framing import BAND_REACH, Band, Box, Circle, Projection, outline
 
 ROPE_COLOR = "#1f77b4"

@@ -26,7 +26,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-PACKAGE_DIR = Path(__file__).resolve().parent
+PACKAGE_DIR = Path(__file__).resolve().parent.parent   # the ropesim package
 KEEP = 3   # kernel folders kept per cache location (the current one and the two used before it)
 
 

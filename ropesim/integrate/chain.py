@@ -32,7 +32,7 @@ import numpy as np
 from numba import njit
 
 from .health import BOX, DRAG, E0, HELD, OK, SCALE, balance_status, save_frame, verdict
-from .kernel import BENDING, GRAVITY, GUIDES, THROWER
+from ..model.terms import BENDING, GRAVITY, GUIDES, THROWER
 from .kick import LANES, _lanes
 
 BULK_FIXED = 1        # bulk = [1 / m, then per kick stage: decay, gain, reach]

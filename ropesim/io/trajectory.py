@@ -173,7 +173,7 @@ class Trajectory:
     @classmethod
     def open(cls, folder: str | Path) -> "Trajectory":
         """Read a run folder lazily; raises :class:`RunFolderError` with one clear line if it is unusable."""
-        from .loader import SceneError, load_scene
+        from ..scene.loader import SceneError, load_scene
 
         folder = Path(folder)
         if not folder.is_dir():

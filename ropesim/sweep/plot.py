@@ -9,8 +9,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from .atomic import atomic_output
-from .sweep import Axis, SweepError, _is_number, _label, _numeric_axis, toml_value
+from ..io.atomic import atomic_output
+from .core import Axis, SweepError, _is_number, _label, _numeric_axis, toml_value
 
 
 def plot_figure(rows: list[dict], axes: list[Axis], figure: str, folder: Path, title: str = "") -> Path:

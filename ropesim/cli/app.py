@@ -41,7 +41,7 @@ def fail(message: str, code: int = EXIT_BAD_INPUT) -> None:
 
 
 def _load(scene_file: Path, sets: list[str] | None):
-    from .loader import SceneError, load_scene
+    from ..scene.loader import SceneError, load_scene
 
     try:
         return load_scene(scene_file, sets or [])
@@ -64,7 +64,7 @@ def run(
 ) -> None:
     """Run a scene and write trajectory.npz, scene.toml and summary.json into its run folder."""
     from .report import print_summary
-    from .run import BLEW_UP, INTERRUPTED, simulate
+    from ..run import BLEW_UP, INTERRUPTED, simulate
 
     scene = _load(scene_file, sets)
     _check_time_step(scene, scene_file, force, quiet)
@@ -88,9 +88,9 @@ def run(
 
 def _check_time_step(scene, scene_file: Path, force: bool, quiet: bool) -> None:
     """Refuse a dt above the stability bound (exit 2) unless --force; warn above 80 % of it."""
-    from .analysis.stability import WARN_FRACTION, time_step_verdict
-    from .build import build
-    from .run import TimeGrid
+    from ..analysis.stability import WARN_FRACTION, time_step_verdict
+    from ..model.build import build
+    from ..run import TimeGrid
 
     method, dt = scene.integrator.method, TimeGrid.of(scene).dt
     verdict, bound = time_step_verdict(build(scene), method, dt)
@@ -139,7 +139,7 @@ def sweep(
 
     Exits 3 if any run did not complete (each is recorded with its error in results.csv), 130 if interrupted.
     """
-    from .sweep import SweepError, run_sweep
+    from ..sweep.core import SweepError, run_sweep
 
     try:
         result = run_sweep(scene_file, sets or [], out=out, jobs=jobs, scheduler=scheduler, plots=plots or [],
@@ -181,8 +181,8 @@ QuietOpt = Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but
 
 def _picture(make):
     """Call ``make()``; an unusable run folder or request, or an unwritable output, prints one line, exits 2."""
-    from .render import RenderError
-    from .trajectory import RunFolderError
+    from ..render import RenderError
+    from ..io.trajectory import RunFolderError
 
     try:
         return make()
@@ -195,8 +195,8 @@ def _picture(make):
 
 
 def _animate(run_dir: Path, out: Optional[Path], quiet: bool, **options) -> None:
-    from .render.animate import animate as make
-    from .trajectory import Trajectory
+    from ..render.animate import animate as make
+    from ..io.trajectory import Trajectory
 
     target = out if out is not None else run_dir / "animation.gif"
     note = (lambda message: typer.echo(f"ropesim: {message}", err=True))
@@ -246,9 +246,9 @@ def frames(
     quiet: QuietOpt = False,
 ) -> None:
     """One PNG of selected frames of a run, side by side or overlaid."""
-    from .render.frames import frame_sheet
-    from .render.timeline import parse_times
-    from .trajectory import Trajectory
+    from ..render.frames import frame_sheet
+    from ..render.timeline import parse_times
+    from ..io.trajectory import Trajectory
 
     target = out if out is not None else run_dir / "frames.png"
     result = _picture(lambda: frame_sheet(
@@ -271,8 +271,8 @@ def plot(
     A towed rope's angle is plotted along its length at the end, against the exact steady state; a string
     shooter's loop inclination over time.
     """
-    from .render.plots import plot_run
-    from .trajectory import Trajectory
+    from ..render.plots import plot_run
+    from ..io.trajectory import Trajectory
 
     target = out if out is not None else run_dir / "plots.png"
     result = _picture(lambda: plot_run(Trajectory.open(run_dir), target))
@@ -287,7 +287,7 @@ MethodsOpt = Annotated[Optional[str], typer.Option(
 
 
 def _methods(text: str | None) -> list[str] | None:
-    from .integrators import METHODS
+    from ..integrate.splitting import METHODS
 
     if not text:
         return None
@@ -328,7 +328,7 @@ def accuracy(
     Prints the table and each method's observed order of convergence; writes accuracy.csv and a
     work-precision plot (error against kernel wall time and against force evaluations).
     """
-    from .analysis.accuracy import accuracy_report, plot, write_csv
+    from ..analysis.accuracy import accuracy_report, plot, write_csv
     from .report import print_accuracy
 
     scene = _load(scene_file, sets)
@@ -365,7 +365,7 @@ def stability(
     Each probe runs the scene from a slightly perturbed start; the blow-up dt of every explicit method is also
     measured by bisection and printed beside its predicted bound.
     """
-    from .analysis.stability import plot_sweep, stability_sweep, write_sweep
+    from ..analysis.stability import plot_sweep, stability_sweep, write_sweep
     from .report import print_stability
 
     scene = _load(scene_file, sets)

@@ -27,9 +27,9 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .forces.thrower import box_of, smooth_step, weight_at
+from ..model.forces.thrower import box_of, smooth_step, weight_at
 from .health import BOX, DRAG, HELD, NEWTON_FAILED, OK, end_step, held_power, place_held, power
-from .kernel import BENDING, GUIDES, THROWER, accelerations, box_accelerations
+from ..model.terms import BENDING, GUIDES, THROWER, accelerations, box_accelerations
 
 GAMMA = 1.0 - 1.0 / math.sqrt(2.0)
 NEWTON_TOL = 1e-11      # Newton stops when no free node's position changes by more than this times l

@@ -11,10 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import scene as S
+from ..scene import schema as S
 from .forces.guides import GUIDE_PARAMS
 from .forces.thrower import THROWER_PARAMS
-from .kernel import BENDING, GRAVITY, GUIDES, N_FLAGS, THROWER
+from .terms import BENDING, GRAVITY, GUIDES, N_FLAGS, THROWER
 
 
 @dataclass

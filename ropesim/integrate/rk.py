@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit
 
 from .health import BOX, DRAG, HELD, OK, end_step, held_power, place_held, power
-from .kernel import GUIDES, THROWER, accelerations, box_accelerations
+from ..model.terms import GUIDES, THROWER, accelerations, box_accelerations
 
 
 @dataclass(frozen=True)
@@ -43,7 +43,7 @@ class RungeKutta:
     @property
     def stability_limit(self) -> float:
         """Largest h omega for which the method stays bounded on x'' = -omega^2 x (where |R(i y)| <= 1)."""
-        from .integrators import stable_step
+        from .splitting import stable_step
 
         return stable_step(self, 1.0)
 

@@ -34,9 +34,9 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
 
-from . import scene as S
-from .loader import SceneError, load_scene, parse_override, scene_from_toml
-from .trajectory import SCENE, SUMMARY, TRAJECTORY, write_text_atomic
+from ..scene import schema as S
+from ..scene.loader import SceneError, load_scene, parse_override, scene_from_toml
+from ..io.trajectory import SCENE, SUMMARY, TRAJECTORY, write_text_atomic
 
 RESULTS = "results.csv"
 FIXED_COLUMNS = ("run", "status", "error")
@@ -230,7 +230,7 @@ def plan(scene_file: str | Path, sets: list[str]) -> tuple[S.Scene, list[Axis], 
     text = Path(scene_file).read_text(encoding="utf-8")
     combos = list(itertools.product(*(a.values for a in axes)))
     names = _folder_names(axes, combos)
-    from .scene import scene_to_toml
+    from ..scene.schema import scene_to_toml
 
     points = []
     for combo, name in zip(combos, names):
@@ -260,7 +260,7 @@ def is_finished(folder: Path, scene_toml: str) -> bool:
 
 def run_point(scene_toml: str, folder: str) -> dict:
     """Run one resolved scene into ``folder``, exactly as ``ropesim run`` does; returns its summary."""
-    from .run import simulate
+    from ..run import simulate
 
     scene = scene_from_toml(scene_toml, source=str(Path(folder) / SCENE))
     return simulate(scene, folder).summary
@@ -394,14 +394,14 @@ def run_sweep(scene_file: str | Path, sets: list[str], out: str | Path | None = 
 
     outcomes: dict[str, Outcome] = {}
     result = SweepResult(rows=[], csv_path=root / RESULTS, swept=swept, skipped=len(done), ran=len(todo))
-    from .sweep_progress import SweepProgress
+    from .progress import SweepProgress
 
     with SweepProgress(len(points), quiet) as progress:
         progress.skipped(len(done), root)
         try:
             if todo:
                 if scheduler is not None:
-                    from .sweep_dask import run_dask
+                    from .dask import run_dask
 
                     results = run_dask(todo, scheduler)
                 else:
@@ -417,7 +417,7 @@ def run_sweep(scene_file: str | Path, sets: list[str], out: str | Path | None = 
             root.mkdir(parents=True, exist_ok=True)
             write_table(result.rows, swept, result.csv_path)
     if not result.interrupted:
-        from .sweep_plot import plot_figure
+        from .plot import plot_figure
 
         for figure in plots:
             result.plots.append(plot_figure(result.rows, axes, figure, root, title=base.name))

@@ -16,8 +16,8 @@ from typing import Iterator
 
 import numpy as np
 
-from .sweep import Outcome, Point, SweepError, _outcome, run_point_safely
-from .trajectory import SCENE, SUMMARY, TRAJECTORY, write_json_atomic, write_npz_atomic, write_text_atomic
+from .core import Outcome, Point, SweepError, _outcome, run_point_safely
+from ..io.trajectory import SCENE, SUMMARY, TRAJECTORY, write_json_atomic, write_npz_atomic, write_text_atomic
 
 CONNECT_TIMEOUT = "20s"
 

@@ -7,7 +7,7 @@ from pathlib import Path
 from rich.console import Console
 from rich.table import Table
 
-from .scene import Scene
+from ..scene.schema import Scene
 
 
 def _console() -> Console:
@@ -69,8 +69,8 @@ def print_summary(summary: dict, folder: Path) -> None:
 
 def print_check(scene: Scene, source: Path) -> None:
     """What a scene contains, and its stability bounds, without running it."""
-    from .build import build
-    from .run import TimeGrid
+    from ..model.build import build
+    from ..run import TimeGrid
 
     model = build(scene)
     grid = TimeGrid.of(scene)
@@ -116,7 +116,7 @@ def print_check(scene: Scene, source: Path) -> None:
 
 def stability_rows(model, method: str, dt: float) -> list[tuple[str, str]]:
     """The check table's stability rows: both bounds on omega_max and every method's largest stable dt."""
-    from .analysis.stability import WARN_FRACTION, bounds, drag_rates, explicit_damping
+    from ..analysis.stability import WARN_FRACTION, bounds, drag_rates, explicit_damping
 
     g, s, rows = bounds(model)
     if g <= 0:
@@ -156,7 +156,7 @@ def stability_rows(model, method: str, dt: float) -> list[tuple[str, str]]:
 
 def print_accuracy(report, folder: Path) -> None:
     """The accuracy table, the reference's convergence check and each method's observed order."""
-    from .analysis.accuracy import REFERENCE_FLOOR
+    from ..analysis.accuracy import REFERENCE_FLOOR
 
     ref = report.reference
     table = Table(title=f"{report.scene.name}: error at t = {report.t_end:g} s against {ref.method} at dt = "

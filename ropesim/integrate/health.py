@@ -20,7 +20,7 @@ W_box [J], and the initial mechanical energy E0 and the energy scale used above.
 import numpy as np
 from numba import njit
 
-from .kernel import mechanical_energy
+from ..model.terms import mechanical_energy
 
 OK, NON_FINITE, OVERSTRETCH, RUNAWAY_ENERGY, NEWTON_FAILED = 0, 1, 2, 3, 4
 STATUS_NAMES = {OK: "ok", NON_FINITE: "non-finite", OVERSTRETCH: "overstretched", RUNAWAY_ENERGY: "runaway energy",

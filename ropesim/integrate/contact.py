@@ -19,8 +19,8 @@ import math
 
 from numba import njit
 
-from .forces.thrower import box_of, smooth_step, weight_at
-from .kernel import GUIDES, THROWER
+from ..model.forces.thrower import box_of, smooth_step, weight_at
+from ..model.terms import GUIDES, THROWER
 
 
 @njit(cache=True, error_model="numpy")

@@ -38,10 +38,10 @@ from numba import njit
 
 from .health import BOX, DRAG, HELD, NON_FINITE, OK, end_step, held_power, place_held  # noqa: F401
 from .contact import exact_contact_kicks
-from .forces.guides import add_guides
-from .forces.springs import add_pair_springs, set_chain_springs
-from .forces.thrower import add_thrower
-from .kernel import BENDING, GRAVITY, GUIDES, THROWER, box_accelerations
+from ..model.forces.guides import add_guides
+from ..model.forces.springs import add_pair_springs, set_chain_springs
+from ..model.forces.thrower import add_thrower
+from ..model.terms import BENDING, GRAVITY, GUIDES, THROWER, box_accelerations
 from .kick import box_work, kick_drift
 
 
@@ -139,7 +139,7 @@ def _pefrl() -> SplittingScheme:
 
 
 def _methods() -> dict:
-    from .implicit import SDIRK2
+    from .sdirk import SDIRK2
     from .rk import RK4
 
     schemes = (

@@ -1,0 +1,1 @@
+"""Files: the run folder (frames, trajectory, summary), atomic writes, and where compiled kernels are cached."""

@@ -1,0 +1,1 @@
+"""Parameter sweeps: every combination of ``--set`` values, in parallel or on a Dask cluster, resumable."""
