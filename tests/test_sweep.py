@@ -20,9 +20,9 @@ from typer.testing import CliRunner
 import ropesim
 from ropesim.cli.app import app
 from ropesim.scene.loader import parse_override
-from ropesim.sweep.core import (
-    TIMING_COLUMNS, Point, SweepError, parse_axis, plan, read_table, run_local, run_sweep, toml_value,
-)
+from ropesim.sweep.core import TIMING_COLUMNS, read_table, run_sweep
+from ropesim.sweep.plan import Point, SweepError, parse_axis, plan, toml_value
+from ropesim.sweep.points import run_local
 
 UNIFORM = Path(__file__).resolve().parent.parent / "scenarios" / "helicopter_uniform.toml"
 M, G = 5.0, 9.81  # helicopter_uniform: node mass [kg], gravity [m/s^2]

@@ -90,7 +90,7 @@ def _check_time_step(scene, scene_file: Path, force: bool, quiet: bool) -> None:
     """Refuse a dt above the stability bound (exit 2) unless --force; warn above 80 % of it."""
     from ..analysis.stability import WARN_FRACTION, time_step_verdict
     from ..model.build import build
-    from ..run import TimeGrid
+    from ..integrate.grid import TimeGrid
 
     method, dt = scene.integrator.method, TimeGrid.of(scene).dt
     verdict, bound = time_step_verdict(build(scene), method, dt)
@@ -139,7 +139,8 @@ def sweep(
 
     Exits 3 if any run did not complete (each is recorded with its error in results.csv), 130 if interrupted.
     """
-    from ..sweep.core import SweepError, run_sweep
+    from ..sweep.core import run_sweep
+    from ..sweep.plan import SweepError
 
     try:
         result = run_sweep(scene_file, sets or [], out=out, jobs=jobs, scheduler=scheduler, plots=plots or [],
@@ -287,7 +288,7 @@ MethodsOpt = Annotated[Optional[str], typer.Option(
 
 
 def _methods(text: str | None) -> list[str] | None:
-    from ..integrate.splitting import METHODS
+    from ..integrate.methods import METHODS
 
     if not text:
         return None

@@ -16,7 +16,8 @@ from typing import Iterator
 
 import numpy as np
 
-from .core import Outcome, Point, SweepError, _outcome, run_point_safely
+from .plan import Point, SweepError
+from .points import Outcome, _outcome, run_point_safely
 from ..io.trajectory import SCENE, SUMMARY, TRAJECTORY, write_json_atomic, write_npz_atomic, write_text_atomic
 
 CONNECT_TIMEOUT = "20s"

@@ -10,7 +10,7 @@ import re
 from pathlib import Path
 
 from ..io.atomic import atomic_output
-from .core import Axis, SweepError, _is_number, _label, _numeric_axis, toml_value
+from .plan import Axis, SweepError, _is_number, _label, _numeric_axis, toml_value
 
 
 def plot_figure(rows: list[dict], axes: list[Axis], figure: str, folder: Path, title: str = "") -> Path:
