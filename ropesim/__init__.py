@@ -23,7 +23,7 @@ _LAZY = {
     "Scene": "scene.schema", "scene_to_toml": "scene.schema",
     "simulate": "run",
     "Trajectory": "io.trajectory", "RunFolderError": "io.trajectory",
-    "METHODS": "integrate.splitting",
+    "METHODS": "integrate.methods",
 }
 
 

@@ -7,7 +7,7 @@ at 8 m/s, Hookean springs, gravity, linear drag integrated exactly in the kick, 
    spring's force into a buffer, one loop kicking and drifting every free node, `error_model="numpy"`. Both
    loops vectorise. It knows nothing but this scene: no held-node list, no energy ledger, no blow-up checks.
 2. The same step written with vectorised NumPy array operations (buffers preallocated).
-3. ropesim's own compiled loop (:class:`ropesim.run.Stepper`, here on its fast path :mod:`ropesim.chain`),
+3. ropesim's own compiled loop (its splitting integrator, here on its plain stage :mod:`ropesim.integrate.plain`),
    everything included: per-node masses and drag, held nodes, the energy ledger, the blow-up check every
    64 steps.
 
@@ -144,7 +144,7 @@ def same_physics(n: int, steps: int) -> float:
 
 def method_rates(sizes: list[int], work: float, repeats: int) -> dict:
     """Median node-steps per second of every integrator at every size."""
-    from ropesim.integrate.splitting import METHODS
+    from ropesim.integrate.methods import METHODS
 
     out = {}
     for name, method in METHODS.items():
@@ -160,7 +160,7 @@ def method_rates(sizes: list[int], work: float, repeats: int) -> dict:
 def shooter_step_times(repeats: int) -> dict:
     """Median wall time [s] of one step of every integrator on scenarios/shooter_high.toml."""
     import ropesim
-    from ropesim.integrate.splitting import METHODS
+    from ropesim.integrate.methods import METHODS
 
     out = {}
     for name, method in METHODS.items():
@@ -203,7 +203,7 @@ def main() -> None:
     table.add_column("method")
     for n in sizes:
         table.add_column(f"N = {n:,}", justify="right")
-    from ropesim.integrate.splitting import METHODS
+    from ropesim.integrate.methods import METHODS
 
     for name in METHODS:
         table.add_row(name, *(rate(rates[name, n], 1) for n in sizes))

@@ -1,7 +1,7 @@
-"""Where the fast path's time goes against the yardstick: its loop with the blow-up check and the drag-loss
+"""Where the plain stage's time goes against the yardstick: the splitting loop with the blow-up check and the drag-loss
 work term each switched off.
 
-Same towed rope and yardstick as ``scripts/bench_kernel.py``. ropesim's loop (:func:`ropesim.chain.advance_chain`)
+Same towed rope and yardstick as ``scripts/bench_kernel.py``. ropesim's loop (:func:`ropesim.integrate.splitting.advance_splitting` on its plain stage)
 is called directly three ways, interleaved with the yardstick in one process:
 
 - as run (blow-up check every 64 steps, the drag loss booked in every kick);
@@ -42,18 +42,17 @@ def contenders(n: int, steps: int) -> dict:
         done[0] += steps
 
     out["yardstick"] = yard
-    from ropesim.integrate.chain import advance_chain
+    from ropesim.integrate.base import Schedule
+    from ropesim.integrate.splitting import advance_splitting
 
     for name, check_every, work in (("ropesim as run", 64, True), ("no blow-up check", NEVER, True),
                                     ("no check, no work term", NEVER, False)):
         st = stepper_for(scene)
-        c, m = st.chain, st.model
+        plain, m = st.plain._replace(has_drag=work), st.model
 
-        def run(st=st, c=c, m=m, check_every=check_every, work=work):
-            advance_chain(st.x, st.v, c.spring_forces, c.lost, st.ledger, st.have_acc, st.step, steps, NEVER, h, st.drift,
-                          st.kick, c.bulk, c.exceptions, c.exception_factors, c.saved, st.reuse_force, st.held,
-                          m.mass, m.forces, c.free_mass, c.kinetic0, work, c.scratch, st.limits, NEVER,
-                          st.new_frames(0), check_every)
+        def run(st=st, plain=plain, m=m, check_every=check_every):
+            advance_splitting(st.bundle, st.kicks, plain, st.general, st.held, m.mass, m.params, st.limits,
+                              Schedule(st.step, steps, NEVER, h, NEVER, check_every), st.new_frames(0))
             st.step += steps
 
         run()   # compile this flag combination

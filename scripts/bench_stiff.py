@@ -13,7 +13,8 @@ import time
 
 from ropesim.model.build import build
 from ropesim.scene.loader import scene_from_toml
-from ropesim.run import Stepper, TimeGrid
+from ropesim.integrate.grid import TimeGrid
+from ropesim.integrate.methods import make_integrator
 
 
 def scene(n: int, closed: bool, method: str, steps: int):
@@ -48,7 +49,7 @@ def per_node_step(n: int, closed: bool, method: str, steps: int = 50) -> tuple[f
     model, grid = build(sc), TimeGrid.of(sc)
     best, iters = float("inf"), 0.0
     for _ in range(3):
-        st = Stepper(model, method, grid)
+        st = make_integrator(model, grid, method)
         st.warm_up()
         t = time.perf_counter()
         st.advance(grid.steps)

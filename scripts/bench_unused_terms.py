@@ -21,7 +21,8 @@ from rich.table import Table
 
 import ropesim
 from ropesim.model.build import build
-from ropesim.run import Stepper, TimeGrid
+from ropesim.integrate.grid import TimeGrid
+from ropesim.integrate.methods import make_integrator
 
 ROOT = Path(__file__).resolve().parent.parent
 UNUSED = [
@@ -39,7 +40,7 @@ def kernel_seconds(scene, steps: int, repeats: int) -> float:
     grid = TimeGrid.of(scene)
     times = []
     for _ in range(repeats + 1):
-        stepper = Stepper(model, scene.integrator.method, grid)
+        stepper = make_integrator(model, grid, scene.integrator.method)
         stepper.warm_up()
         start = time.perf_counter()
         stepper.advance(steps)

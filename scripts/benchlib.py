@@ -33,11 +33,13 @@ def towed_scene(nodes: int, method: str = "symplectic_euler", steps: int = 1000,
 
 
 def stepper_for(scene):
-    """A warmed-up :class:`ropesim.run.Stepper` for ``scene`` (kernel compiled or loaded from cache)."""
+    """A warmed-up integrator (:mod:`ropesim.integrate.base`) for ``scene`` (its loop compiled or loaded from
+    the cache)."""
+    from ropesim.integrate.grid import TimeGrid
+    from ropesim.integrate.methods import make_integrator
     from ropesim.model.build import build
-    from ropesim.run import Stepper, TimeGrid
 
-    stepper = Stepper(build(scene), scene.integrator.method, TimeGrid.of(scene))
+    stepper = make_integrator(build(scene), TimeGrid.of(scene))
     stepper.warm_up()
     return stepper
 

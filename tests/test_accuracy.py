@@ -23,7 +23,7 @@ import ropesim
 from ropesim.analysis.accuracy import accuracy_report, observed_order, run_once
 from ropesim.model.build import build
 from ropesim.cli.app import app
-from ropesim.integrate.splitting import METHODS
+from ropesim.integrate.methods import METHODS
 from ropesim.scene.loader import scene_from_toml
 from ropesim.scene.schema import Integrator
 
@@ -103,7 +103,7 @@ VACUUM = textwrap.dedent("""
 
 def energy_error(method: str, dt: float) -> np.ndarray:
     """|E(t) - E(0)| per saved frame of a rope pendulum released horizontally in a vacuum (nothing flows)."""
-    from ropesim.analysis.energy import energy_terms
+    from ropesim.model.energy import energy_terms
 
     scene = scene_from_toml(VACUUM, overrides=[f"integrator.method={method}", f"integrator.dt={dt}"])
     traj = ropesim.simulate(scene)
@@ -280,14 +280,14 @@ def test_exact_contact_kick_solves_the_linear_kick_equation():
 
     def rhs(vel):
         acc = np.zeros_like(x)
-        accelerations(x, vel, acc, model.forces)
+        accelerations(x, vel, acc, model.params)
         return acc - gamma * vel
 
     for tau in (0.01, -0.004):
         out, nodes = np.zeros_like(x), np.zeros(model.nodes, dtype=np.int64)
         acc = np.zeros_like(x)
-        accelerations(x, v, acc, model.forces)
-        count = exact_contact_kicks(x, v, acc, out, nodes, tau, gamma, free, model.forces)
+        accelerations(x, v, acc, model.params)
+        count = exact_contact_kicks(x, v, acc, out, nodes, tau, gamma, free, model.params)
         assert 10 in nodes[:count]
         w, steps = v.copy(), 2000
         h = tau / steps
@@ -305,7 +305,7 @@ def test_smooth_step_and_box_weight():
 
     assert smooth_step(0.0, 0.1) == 0.5 and smooth_step(1e-9, 0.0) == 1.0 and smooth_step(0.0, 0.0) == 0.0
     assert smooth_step(2.0, 0.1) == 1.0 and smooth_step(-2.0, 0.1) == 0.0  # exactly, beyond 20 widths
-    p = build(shooter("thrower.edge_width=0.05")).forces[5]
+    p = build(shooter("thrower.edge_width=0.05")).params.thrower
     xs = np.linspace(0.0, 8.0, 80001)  # from the box's centre across its right edge at x = 4, in 0.1 mm steps
     w = np.array([box_weight(np.array([[x], [0.0]]), 0, p) for x in xs])
     assert w[0] == 1.0 and w[-1] == 0.0 and np.all(np.diff(w) <= 0)
@@ -320,19 +320,18 @@ def test_banded_newton_solver_matches_a_dense_solve(n, dim, bending, closed, see
     """The stiff integrator's linear solver (banded Cholesky, Woodbury correction for a loop's wrap-around)
     solves a random positive definite rope matrix, with springs between neighbours and second neighbours, as
     a dense solve does, to round-off."""
+    from ropesim.integrate.banded import factor, solve, woodbury
     from ropesim.model.build import spring_count
-    from ropesim.integrate.sdirk import _add_pair, _factor, _solve, band_width, scratch
+    from ropesim.model.jacobian import Jacobian, add_pair, band_width
 
     if closed and bending and n < 5:
         return  # the loader refuses bending on loops of fewer than 5 nodes
     rng = np.random.default_rng(seed)
-    w, cyclic = band_width(closed, n, bending)
-    work = scratch(dim, n, bending, closed)
-    band, corner = work[0], work[6]
-    band[:] = 0.0
-    corner[:] = 0.0
+    w, cyclic = band_width(closed, n, 2 if bending else 1)
+    jac = Jacobian(np.zeros(((w + 1) * dim, n * dim)), np.zeros((w * dim, w * dim)), np.zeros((dim, dim)), w)
+    wood = woodbury(n * dim, w * dim)
+    band, corner = jac.band, jac.corner
     dense = np.zeros((n * dim, n * dim))
-    free = np.ones(n, dtype=np.bool_)
     for stride in (1, 2) if bending else (1,):
         for i in range(spring_count(n, stride, closed)):
             j = (i + stride) % n
@@ -340,7 +339,8 @@ def test_banded_newton_solver_matches_a_dense_solve(n, dim, bending, closed, see
                 continue
             u = rng.standard_normal((dim, dim))
             blk = u @ u.T  # a random symmetric positive semi-definite spring block
-            _add_pair(band, corner, n, dim, w, i, j, blk, True, True)
+            jac.blk[:] = blk
+            add_pair(jac, n, i, j, True, True)
             for a, b in ((i, i), (j, j)):
                 dense[a * dim:(a + 1) * dim, b * dim:(b + 1) * dim] += blk
             dense[i * dim:(i + 1) * dim, j * dim:(j + 1) * dim] -= blk
@@ -350,8 +350,8 @@ def test_banded_newton_solver_matches_a_dense_solve(n, dim, bending, closed, see
     dense[np.diag_indices(n * dim)] += mass
     rhs = rng.standard_normal(n * dim)
     p = band.shape[0] - 1
-    assert _factor(band, corner, cyclic, p, work)
+    assert factor(band, corner, cyclic, p, wood)
     x = rhs.copy()
-    _solve(band, cyclic, p, x, work)
+    solve(band, corner, cyclic, p, x, wood)
     expected = np.linalg.solve(dense, rhs)
     assert np.allclose(x, expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max())

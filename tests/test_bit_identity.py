@@ -73,7 +73,8 @@ def with_method(scene, method: str):
 def run_case(scene) -> dict:
     """Frames (t, x, v), the ledger per frame, status, steps and force evaluations of one run, in memory."""
     from ropesim.model.build import build
-    from ropesim.run import TimeGrid, integrate
+    from ropesim.integrate.grid import TimeGrid
+    from ropesim.run import integrate
     from ropesim.io.trajectory import FrameStore
 
     model = build(scene)

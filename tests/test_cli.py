@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 
 from ropesim.model.build import build
 from ropesim.cli.app import app
-from ropesim.integrate.splitting import METHODS
+from ropesim.integrate.methods import METHODS
 from ropesim.scene.loader import load_scene
 
 from conftest import ROOT, SCENARIOS

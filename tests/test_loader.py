@@ -9,7 +9,6 @@ import re
 import tomllib
 import warnings
 from dataclasses import MISSING, fields, replace
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,8 +20,10 @@ from ropesim.scene import schema as S
 from ropesim.model.build import build
 from ropesim.scene.loader import SceneError, apply_override, load_scene, parse_override, scene_from_toml
 from ropesim.analysis.stability import time_step_verdict
-from ropesim.integrate.splitting import METHODS
-from ropesim.run import BLEW_UP, COMPLETED, Stepper, TimeGrid, simulate
+from ropesim.integrate.methods import METHODS
+from ropesim.integrate.grid import TimeGrid
+from ropesim.integrate.methods import make_integrator
+from ropesim.run import BLEW_UP, COMPLETED, simulate
 
 from conftest import ROOT, SCENARIOS
 
@@ -614,7 +615,7 @@ def _accepted_or_one_line(text: str, sets=()):
         assert model.x0.shape == (scene.dimension, scene.rope.nodes)
         grid = TimeGrid.of(scene)
         time_step_verdict(model, scene.integrator.method, scene.integrator.dt)
-        Stepper(model, scene.integrator.method, grid)
+        make_integrator(model, grid, scene.integrator.method)
     assert scene_from_toml(S.scene_to_toml(scene), source="again.toml") == scene
     return scene
 

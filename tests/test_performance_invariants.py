@@ -108,7 +108,7 @@ def test_ensure_writable_cache_tells_an_already_imported_numba(tmp_path, monkeyp
 PROBE = """
 import json, sys
 import ropesim
-from ropesim.integrate.chain import advance_chain as advance   # the towed rope's kernel (the general one's is alike)
+from ropesim.integrate.splitting import advance_splitting as advance   # every splitting scheme's kernel
 scene = ropesim.load_scene(sys.argv[1], ["integrator.t_end=0.05"])
 ropesim.simulate(scene)
 stats = advance.stats

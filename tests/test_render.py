@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from PIL import Image
 
 import ropesim
-from ropesim.analysis.energy import energy_terms
+from ropesim.model.energy import energy_terms
 from ropesim.analysis.summary import largest_stretch
 from ropesim.model.build import build
 from ropesim.render import RenderError, framing

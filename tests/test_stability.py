@@ -16,7 +16,8 @@ from ropesim.analysis.stability import (gershgorin_frequency, measured_dt, predi
                                         stability_sweep)
 from ropesim.model.build import build
 from ropesim.cli.app import app
-from ropesim.integrate.splitting import METHODS, stable_step
+from ropesim.integrate.base import stable_step
+from ropesim.integrate.methods import METHODS
 from ropesim.scene.loader import scene_from_toml
 
 from conftest import SCENARIOS

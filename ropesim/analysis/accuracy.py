@@ -25,7 +25,7 @@ import numpy as np
 
 from ..model.build import build
 from ..integrate.health import E0, OK, STATUS_NAMES
-from ..integrate.splitting import METHODS, get_method
+from ..integrate.methods import METHODS, get_method
 from ..scene.schema import Scene
 from .stability import predicted_dt
 
@@ -89,21 +89,22 @@ def single_frame(scene: Scene, dt: float, method: str) -> Scene:
 def run_once(scene: Scene, method: str, dt: float, repeats: int = 1, exact_contacts: bool | None = None) -> RunResult:
     """Run ``scene`` to t_end with ``method`` at ``dt`` ``repeats`` times (timing only the kernel).
 
-    ``exact_contacts`` overrides whether a splitting scheme kicks nodes touching the box or a circle exactly
-    (see :mod:`ropesim.contact`; by default it does when their edges are smoothed).
+    ``exact_contacts`` overrides whether a method that can kicks nodes touching the box or a circle exactly
+    (see :mod:`ropesim.integrate.contact`; by default it does when their edges are smoothed).
     """
-    from .energy import energy_terms
+    from ..integrate.grid import TimeGrid
     from ..integrate.health import BOX, DRAG, HELD
-    from ..run import Stepper, TimeGrid
+    from ..integrate.methods import make_integrator
+    from ..model.energy import energy_terms
 
     scene = single_frame(scene, dt, method)
     model = build(scene)
     grid = TimeGrid.of(scene)
     times, stepper, status = [], None, OK
     for _ in range(max(1, repeats)):
-        stepper = Stepper(model, method, grid)
-        if exact_contacts is not None and hasattr(stepper, "exact_contacts"):
-            stepper.exact_contacts = exact_contacts
+        stepper = make_integrator(model, grid, method)
+        if exact_contacts is not None and get_method(method).exact_contact_kicks:
+            stepper.set_exact_contacts(exact_contacts)
         stepper.warm_up()
         start = time.perf_counter()
         _, _, status, _ = stepper.advance(grid.steps)

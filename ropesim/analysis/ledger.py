@@ -22,7 +22,7 @@ import numpy as np
 
 from ..model.build import Model
 from ..integrate.health import LEDGER_COLUMNS
-from .energy import energy_terms
+from ..model.energy import energy_terms
 
 LEDGER = "ledger.npz"
 FRAME_BLOCK = 256

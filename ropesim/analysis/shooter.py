@@ -50,5 +50,5 @@ def nodes_in_thrower(model: Model, x: np.ndarray) -> int:
     from ..model.forces.thrower import inside_box
 
     xdn = np.ascontiguousarray(np.asarray(x).T)
-    box = model.forces[5]
+    box = model.params.thrower
     return int(sum(inside_box(xdn, i, box) for i in range(xdn.shape[1])))

@@ -26,23 +26,22 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.build import Model, spring_count
-from ..integrate.splitting import METHODS, get_method, stable_step
+from ..model.terms import declared_terms
+from ..integrate.base import stable_step
+from ..integrate.methods import METHODS, get_method
 
 SPECTRAL_MAX_NODES = 800
 WARN_FRACTION = 0.8       # `ropesim run` warns above this fraction of the bound, refuses above the bound
 
 
 def _laplacian_rows(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(i, j, k) of every spring between two free nodes, and the diagonal (N,) of L."""
-    scene = model.scene
+    """(i, j, k) of every spring between two free nodes, and the diagonal (N,) of L (every term's springs)."""
     n = model.nodes
     diag = np.zeros(n)
     ii, jj, kk = [], [], []
-    pairs = [(1, scene.rope.stiffness)]
-    if scene.bending is not None:
-        pairs.append((2, scene.bending.stiffness))
+    pairs = [pair for term in declared_terms(model.scene) for pair in (term.springs(model) or ())]
     for stride, k in pairs:
-        i = np.arange(spring_count(n, stride, scene.rope.closed))
+        i = np.arange(spring_count(n, stride, model.scene.rope.closed))
         j = (i + stride) % n
         keep = i != j
         i, j = i[keep], j[keep]
@@ -56,30 +55,15 @@ def _laplacian_rows(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def contact_stiffness(model: Model) -> float:
-    """The largest omega0^2 [1/s^2] of the thrower's and guides' centring springs (0 without them)."""
-    scene = model.scene
-    w0 = scene.thrower.resolved_omega0 if scene.thrower is not None else 0.0
-    extra = w0 * w0  # inf, not OverflowError, when absurdly large
-    for guide in scene.guides:
-        w = guide.omega0 if guide.omega0 is not None else (
-            scene.thrower.resolved_omega0 if scene.thrower is not None else 0.0)
-        extra = max(extra, w * w)
-    return extra
+    """The largest omega^2 [1/s^2] a term adds to a single node (the thrower's and guides' centring springs; 0
+    without them)."""
+    return max((term.node_stiffness(model) for term in declared_terms(model.scene)), default=0.0)
 
 
 def explicit_damping(model: Model) -> float:
-    """The largest velocity-damping rate [1/s] a method evaluates explicitly (thrower and guides)."""
-    scene = model.scene
-    rate = 0.0
-    if scene.thrower is not None:
-        t = scene.thrower
-        free_mass = model.mass[~model.held] if (~model.held).any() else model.mass
-        rate = max(t.b_thrower / float(free_mass.min()), 2 * t.damping_ratio * t.resolved_omega0)
-    for guide in scene.guides:
-        w = guide.omega0 if guide.omega0 is not None else (
-            scene.thrower.resolved_omega0 if scene.thrower is not None else 0.0)
-        rate = max(rate, 2 * guide.damping_ratio * w)
-    return rate
+    """The largest velocity-damping rate [1/s] a term applies that a method may evaluate explicitly (the
+    thrower's and guides')."""
+    return max((term.damping(model) for term in declared_terms(model.scene)), default=0.0)
 
 
 def gershgorin_frequency(model: Model) -> float:
@@ -133,19 +117,11 @@ def predicted_dt(model: Model, method: str, omega: float | None = None) -> float
     omega = spectral_frequency(model) if omega is None else omega
     low, high = drag_rates(model)
     damping = explicit_damping(model)
-    if scheme.kind == "splitting" and smooth_contacts(model):
+    if scheme.exact_contact_kicks and model.smooth_contacts:
         high, damping = high + damping, 0.0  # the contacts' damping is integrated exactly, like drag
     # Damping can widen or narrow a method's interval, and the fastest mode may sit on lightly or heavily
     # damped nodes: take the worst of the extremes.
     return min(stable_step(scheme, omega, f, d) for f in {0.0, damping} for d in {low, high})
-
-
-def smooth_contacts(model: Model) -> bool:
-    """True when the box's or a circle's edges are smoothed: the splitting schemes then kick the nodes they
-    touch exactly (:mod:`ropesim.contact`)."""
-    scene = model.scene
-    return (scene.thrower is not None and scene.thrower.edge_width > 0) or any(g.edge_width > 0
-                                                                                 for g in scene.guides)
 
 
 @dataclass(frozen=True)
@@ -199,10 +175,11 @@ def probe(scene, method: str, dt: float, steps: int = PROBE_STEPS) -> bool:
     """
     import dataclasses
 
-    from ..model.build import build
+    from ..integrate.grid import TimeGrid
     from ..integrate.health import BOX, DRAG, E0, HELD, OK, SCALE
-    from ..run import Stepper, TimeGrid
-    from .energy import energy_terms
+    from ..integrate.methods import make_integrator
+    from ..model.build import build
+    from ..model.energy import energy_terms
 
     integ = dataclasses.replace(scene.integrator, method=method, dt=dt, t_end=steps * dt)
     out = dataclasses.replace(scene.output, interval=steps * dt)
@@ -212,7 +189,7 @@ def probe(scene, method: str, dt: float, steps: int = PROBE_STEPS) -> bool:
     free = ~model.held
     model.x0[:, free] += PERTURBATION * scene.rope.segment_length * rng.standard_normal((model.dim, free.sum()))
     grid = TimeGrid.of(scene)
-    stepper = Stepper(model, method, grid)
+    stepper = make_integrator(model, grid, method)
     _, _, status, _ = stepper.advance(grid.steps)
     if status != OK:
         return False

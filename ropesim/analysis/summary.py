@@ -7,7 +7,7 @@ import numpy as np
 from .. import __version__
 from ..model.build import Model
 from ..model.forces.springs import pair_spring_stretch
-from .energy import energy_terms
+from ..model.energy import energy_terms
 from .ledger import ledger_series, ledger_summary
 from .stability import predicted_dt
 from .towed import towed_end, towed_figures

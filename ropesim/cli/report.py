@@ -70,7 +70,7 @@ def print_summary(summary: dict, folder: Path) -> None:
 def print_check(scene: Scene, source: Path) -> None:
     """What a scene contains, and its stability bounds, without running it."""
     from ..model.build import build
-    from ..run import TimeGrid
+    from ..integrate.grid import TimeGrid
 
     model = build(scene)
     grid = TimeGrid.of(scene)

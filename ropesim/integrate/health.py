@@ -52,9 +52,9 @@ def first_non_finite(x):
 
 
 @njit(cache=True, error_model="numpy")
-def check_health(x, v, mass, forces, ledger, limits):
+def check_health(x, v, mass, params, ledger, limits):
     """(status, node): OK and -1 when the state is sane, else the first problem found (see the module doc)."""
-    energy, stretch, node = mechanical_energy(x, v, mass, forces)
+    energy, stretch, node = mechanical_energy(x, v, mass, params)
     return verdict(energy, stretch, node, x, v, ledger, limits)
 
 
@@ -135,17 +135,86 @@ def power(acc, v, mass):
 
 
 @njit(cache=True, error_model="numpy")
-def end_step(done, total_steps, save_every, check_every, h, x, v, mass, forces, ledger, limits, frames, frame):
+def end_step(done, schedule, x, v, mass, params, ledger, limits, frames, frame):
     """After global step ``done`` (1-based): check the state when due and save a frame when due.
 
-    Returns (status, node, frames written so far).
+    ``schedule`` and ``frames`` are the bundles of :mod:`ropesim.integrate.base`. Returns (status, node,
+    frames written so far).
     """
-    saving = done % save_every == 0 or done == total_steps
-    if saving or done % check_every == 0:
-        status, node = check_health(x, v, mass, forces, ledger, limits)
+    saving = done % schedule.save_every == 0 or done == schedule.total_steps
+    if saving or done % schedule.check_every == 0:
+        status, node = check_health(x, v, mass, params, ledger, limits)
         if status != OK:
             return status, node, frame
     if saving:
-        save_frame(frame, done * h, x, v, ledger, frames[0], frames[1], frames[2], frames[3])
+        save_frame(frame, done * schedule.h, x, v, ledger, frames.t, frames.x, frames.v, frames.ledger)
         frame += 1
     return OK, -1, frame
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def due(done, schedule):
+    """True when global step ``done`` needs the end-of-step work (a check or a frame)."""
+    return done % schedule.check_every == 0 or done % schedule.save_every == 0 or done == schedule.total_steps
+
+
+# ------------------------------------------------------------------------- the limits, set up in Python
+
+RUNAWAY_FACTOR = 1.0      # a blow-up: energy balance off by this times the initial energy scale ...
+RUNAWAY_FLOW_FRACTION = 0.2  # ... plus this fraction of the energy that flowed in and out
+STRETCH_SANITY = 4.0      # a spring longer than this many rest lengths (or 4x its static strain) is a blow-up
+
+
+def initial_ledger(model, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """A new ledger (LEDGER_SIZE,): no flows yet, the mechanical energy of (x, v) (D, N) and the energy scale."""
+    from ..model.energy import energy_terms
+
+    ledger = np.zeros(LEDGER_SIZE)
+    ledger[E0] = float(energy_terms(model, x.T, v.T)["total"])
+    ledger[SCALE] = energy_scale(model)
+    return ledger
+
+
+def limits(model) -> np.ndarray:
+    """The blow-up check's limits: largest sane stretch, runaway factor, runaway fraction of the flows."""
+    return np.array([stretch_limit(model), RUNAWAY_FACTOR, RUNAWAY_FLOW_FRACTION])
+
+
+def energy_scale(model) -> float:
+    """The energy scale [J] a blow-up is measured against (before the flows are added, see the module doc).
+
+    Initial kinetic and elastic energy, plus the rope's weight times its length (what gravity can convert),
+    plus every spring stretched by 1 % (so a rope at rest in zero gravity still has a scale).
+    """
+    from ..model.energy import energy_terms
+
+    scene, rope = model.scene, model.scene.rope
+    g = scene.gravity.g if scene.gravity is not None else 0.0
+    terms = energy_terms(model, model.x0.T, model.v0.T)
+    moving = float(terms["total"] - terms.get("gravity", 0.0))
+    length = rope.nodes * rope.segment_length
+    springs = rope.nodes
+    return abs(moving) + float(model.mass.sum()) * g * length + springs * 0.5 * rope.stiffness * (
+        0.01 * rope.segment_length) ** 2
+
+
+def stretch_limit(model) -> float:
+    """Largest sane spring length / rest length [-].
+
+    STRETCH_SANITY, or 1 + STRETCH_SANITY times the strain the rope's whole static load would cause (its
+    weight, drag at the held nodes' speed, the thrower's full drive on the nodes its box can hold), or twice
+    the longest spring at t = 0, whichever is largest. Stable runs of the built-in scenes stay below 1.7; an
+    unstable one that saturates instead of overflowing (bounded garbage) goes past it within a few steps.
+    """
+    from ..model.forces.springs import pair_spring_stretch
+
+    scene, rope = model.scene, model.scene.rope
+    g = scene.gravity.g if scene.gravity is not None else 0.0
+    load = float(model.mass.sum()) * g
+    if model.held_v.size:
+        load += float(model.drag.sum()) * float(np.abs(model.held_v).max())
+    if scene.thrower is not None:
+        in_box = min(rope.nodes, scene.thrower.length / rope.segment_length + 1)
+        load += in_box * scene.thrower.b_thrower * abs(scene.thrower.v_max)
+    initial = float(np.max(pair_spring_stretch(model.x0.T, rope.segment_length, 1, rope.closed), initial=0.0)) + 1.0
+    return max(STRETCH_SANITY, 1.0 + STRETCH_SANITY * load / (rope.stiffness * rope.segment_length), 2.0 * initial)

@@ -11,17 +11,19 @@ Unlike the splitting schemes these methods are not symplectic: their energy erro
 
 from __future__ import annotations
 
+from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
-from .health import BOX, DRAG, HELD, OK, end_step, held_power, place_held, power
-from ..model.terms import GUIDES, THROWER, accelerations, box_accelerations
+from ..model.terms import accelerations, any_applied, applied_accelerations, has_applied
+from .base import Integrator, Method
+from .health import BOX, DRAG, HELD, OK, due, end_step, held_power, place_held, power
 
 
 @dataclass(frozen=True)
-class RungeKutta:
+class RungeKutta(Method):
     """An explicit Runge-Kutta method: ``a`` (strictly lower triangular, as rows), weights ``b``, nodes ``c``."""
 
     name: str
@@ -31,6 +33,11 @@ class RungeKutta:
     c: tuple[float, ...]
     doc: str
     kind: str = "rk"
+    drag_explicit = True
+
+    @property
+    def family(self) -> type:
+        return RungeKuttaFamily
 
     @property
     def evaluations(self) -> int:
@@ -39,13 +46,6 @@ class RungeKutta:
     @property
     def reuses_last_force(self) -> bool:
         return False
-
-    @property
-    def stability_limit(self) -> float:
-        """Largest h omega for which the method stays bounded on x'' = -omega^2 x (where |R(i y)| <= 1)."""
-        from .splitting import stable_step
-
-        return stable_step(self, 1.0)
 
     def amplification(self, h: float, omega: float, gamma_force: float = 0.0, gamma_drag: float = 0.0):
         """One step's 2x2 map of (x, v) for x'' = -omega^2 x - (gamma_force + gamma_drag) x' (both explicit)."""
@@ -72,21 +72,51 @@ RK4 = RungeKutta(
     doc="Classical fourth-order Runge-Kutta, a non-symplectic comparison: 4 force evaluations per step, drag "
         "explicit (so strong drag limits its step too), energy slowly dissipated.")
 
+RKScratch = namedtuple("RKScratch", ["xs", "vs", "kx", "kv", "acc", "acc_box"])
+"""Stage positions and velocities (D, N), stage derivatives (S, D, N), accelerations (D, N)."""
+
+
+class RungeKuttaFamily(Integrator):
+    """The explicit Runge-Kutta family: any :class:`RungeKutta` table, drag an ordinary term of the derivative."""
+
+    def __init__(self, model, grid, method: RungeKutta):
+        super().__init__(model, grid, method)
+        stages = len(method.b)
+        self.tables = method.tables()
+        shape = self.x.shape
+        self.scratch = RKScratch(np.zeros(shape), np.zeros(shape), np.zeros((stages,) + shape),
+                                 np.zeros((stages,) + shape), np.zeros(shape), np.zeros(shape))
+        self.gamma = np.where(model.held, 0.0, model.drag / model.mass)
+        self.has_box = has_applied(model.params)
+
+    @property
+    def force_evaluations(self) -> int:
+        return self.step * self.method.evaluations
+
+    def _run(self, n, frames):
+        m = self.model
+        return advance_rk((self.x, self.v, self.ledger), self.tables, self.scratch, self.held, m.mass, self.gamma,
+                          m.params, self.limits, self.schedule(n), frames)
+
 
 @njit(cache=True, error_model="numpy")
-def advance_rk(x, v, xs, vs, kx, kv, acc, acc_box, ledger, step0, n_steps, total_steps, h, a, b, c, gamma, held,
-               mass, forces, limits, save_every, frames, check_every):
-    """Advance ``n_steps`` Runge-Kutta steps in place; arguments and result as for
-    :func:`ropesim.integrators.advance`. ``xs``, ``vs`` (D, N) and ``kx``, ``kv`` (S, D, N) are scratch;
-    ``gamma`` (N,) is b / m (zero for held nodes)."""
+def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedule, frames):
+    """Advance ``schedule.n_steps`` Runge-Kutta steps in place; the contract of :mod:`ropesim.integrate.base`.
+
+    ``state`` = (x, v, ledger); ``tables`` = (a, b, c); ``gamma`` (N,) is b / m (zero for held nodes).
+    Returns (steps done, frames written, status, node).
+    """
+    x, v, ledger = state
+    a, b, c = tables
+    xs, vs, kx, kv, acc, acc_box = scratch
+    held_idx, held_x0, held_v = held
+    h = schedule.h
     dim, n = x.shape
     stages = b.shape[0]
-    held_idx, held_x0, held_v = held
-    flags = forces[1]
-    has_box = flags[THROWER] != 0 or flags[GUIDES] != 0
+    has_box = any_applied(params.flags)
     frame = 0
-    for s in range(n_steps):
-        step = step0 + s
+    for s in range(schedule.n_steps):
+        step = schedule.step0 + s
         t = step * h
         for st in range(stages):
             for d in range(dim):
@@ -104,7 +134,7 @@ def advance_rk(x, v, xs, vs, kx, kv, acc, acc_box, ledger, step0, n_steps, total
             for j in range(held_idx.shape[0]):
                 for d in range(dim):
                     vs[d, held_idx[j]] = held_v[d, j]
-            accelerations(xs, vs, acc, forces)
+            accelerations(xs, vs, acc, params)
             lost = 0.0
             for d in range(dim):
                 for i in range(n):
@@ -118,7 +148,7 @@ def advance_rk(x, v, xs, vs, kx, kv, acc, acc_box, ledger, step0, n_steps, total
             ledger[DRAG] += wh * lost
             ledger[HELD] += wh * held_power(acc, mass, held_idx, held_v)
             if has_box:
-                box_accelerations(xs, vs, acc_box, forces)
+                applied_accelerations(xs, vs, acc_box, params)
                 ledger[BOX] += wh * power(acc_box, vs, mass)
         for d in range(dim):
             for i in range(n):
@@ -131,12 +161,9 @@ def advance_rk(x, v, xs, vs, kx, kv, acc, acc_box, ledger, step0, n_steps, total
                 v[d, i] += h * dv
         place_held(x, held_idx, held_x0, held_v, (step + 1) * h)
         done = step + 1
-        if done % check_every and done % save_every and done != total_steps:
+        if not due(done, schedule):
             continue  # nothing due: skip the call, whose array arguments cost more than a small rope's step
-        status, node, frame = end_step(done, total_steps, save_every, check_every, h, x, v, mass, forces, ledger,
-                                       limits, frames, frame)
+        status, node, frame = end_step(done, schedule, x, v, mass, params, ledger, limits, frames, frame)
         if status != OK:
             return s + 1, frame, status, node
-    return n_steps, frame, OK, -1
-
-
+    return schedule.n_steps, frame, OK, -1

@@ -9,11 +9,13 @@ V = (X - Xhat) / beta leaves, for the positions X of the free nodes,
 
     R(X) = M (1 + beta gamma_drag) (X - Xhat) - beta M Vhat - beta^2 M a(X, V(X)) = 0,
 
-solved by Newton's method. Its Jacobian, M (1 + beta gamma_drag) + beta^2 H + beta C_v (H the springs',
-bending springs', box's and guides' stiffness, C_v their velocity damping), couples each node only to its
-neighbours and second neighbours: a block banded matrix, factored by a banded Cholesky in O(N) per
-iteration. On a closed loop the wrap-around couples the first and last nodes; a Woodbury correction of rank
-w D (w = 1, or 2 with bending) handles it, still O(N). Negative (compressive) geometric stiffness is left out
+solved by Newton's method. Its Jacobian, M (1 + beta gamma_drag) + beta^2 H + beta C_v (H the force terms'
+stiffness, C_v their velocity damping, each term's blocks from its own module through the term list's
+:func:`~ropesim.model.terms.coupling_jacobian` and :func:`~ropesim.model.terms.node_jacobian`), couples each
+node only to its neighbours and second neighbours: a block banded matrix (:mod:`ropesim.model.jacobian`),
+factored by a banded Cholesky in O(N) per iteration (:mod:`ropesim.integrate.banded`). On a closed loop the
+wrap-around couples the first and last nodes; a Woodbury correction of rank w D (w = 1, or 2 with bending)
+handles it, still O(N). Negative (compressive) geometric stiffness is left out
 of the Jacobian so the matrix stays symmetric positive definite: Newton then converges a little more slowly
 where springs are compressed, but to the same exact stage solution. Held nodes sit at x0 + V (t + c_s h) in
 every stage.
@@ -22,14 +24,18 @@ every stage.
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
-from ..model.forces.thrower import box_of, smooth_step, weight_at
-from .health import BOX, DRAG, HELD, NEWTON_FAILED, OK, end_step, held_power, place_held, power
-from ..model.terms import BENDING, GUIDES, THROWER, accelerations, box_accelerations
+from ..model.jacobian import Jacobian, band_width
+from ..model.terms import accelerations, any_applied, applied_accelerations, coupling_jacobian, coupling_reach
+from ..model.terms import node_jacobian
+from .banded import factor, solve, woodbury
+from .base import Integrator, Method
+from .health import BOX, DRAG, HELD, NEWTON_FAILED, OK, due, end_step, held_power, place_held, power
 
 GAMMA = 1.0 - 1.0 / math.sqrt(2.0)
 NEWTON_TOL = 1e-11      # Newton stops when no free node's position changes by more than this times l
@@ -37,14 +43,18 @@ NEWTON_MAX_ITER = 40
 
 
 @dataclass(frozen=True)
-class Sdirk:
+class Sdirk(Method):
     """The stiff integrator's description; the loop is :func:`advance_sdirk`."""
 
     name: str
     order: int
     doc: str
     kind: str = "implicit"
-    unconditionally_stable: bool = True
+    unconditionally_stable = True
+
+    @property
+    def family(self) -> type:
+        return SdirkFamily
 
     @property
     def evaluations(self) -> int:
@@ -62,9 +72,9 @@ class Sdirk:
 
     def amplification(self, h: float, omega: float, gamma_force: float = 0.0, gamma_drag: float = 0.0):
         lin = np.array([[0.0, 1.0], [-omega * omega, -(gamma_force + gamma_drag)]]) * h
-        solve = np.linalg.inv(np.eye(2) - GAMMA * lin)
-        k1 = solve @ lin
-        k2 = solve @ lin @ (np.eye(2) + (1 - GAMMA) * k1)
+        inverse = np.linalg.inv(np.eye(2) - GAMMA * lin)
+        k1 = inverse @ lin
+        k2 = inverse @ lin @ (np.eye(2) + (1 - GAMMA) * k1)
         return np.eye(2) + (1 - GAMMA) * k1 + GAMMA * k2
 
 
@@ -72,194 +82,54 @@ SDIRK2 = Sdirk("sdirk2", 2,
                "The stiff integrator: L-stable two-stage SDIRK (Alexander 1977), second order, stable at any "
                "time step; each stage a Newton solve with the rope's banded Jacobian (O(N)), drag implicit.")
 
+Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol"])
+"""The Newton solve's matrix (:class:`~ropesim.model.jacobian.Jacobian`), Woodbury arrays, right-hand side
+(N D,), whether the loop wraps around, and the tolerance [m] on the largest position update."""
 
-def band_width(closed: bool, nodes: int, bending: bool) -> tuple[int, bool]:
-    """(block half-bandwidth w, whether a wrap-around correction is needed)."""
-    w = 2 if bending else 1
-    return w, bool(closed and nodes >= w + 2)
+Stage = namedtuple("Stage", ["xh", "vh", "X", "V", "acc", "acc_box"])
+"""A stage's known part (xh, vh), its unknowns (X, V) and the accelerations there, all (D, N)."""
 
-
-def scratch(dim: int, nodes: int, bending: bool, closed: bool) -> tuple:
-    """Work arrays for :func:`advance_sdirk`, allocated once per run."""
-    w, _ = band_width(closed, nodes, bending)
-    nt = dim * nodes
-    p = (w + 1) * dim - 1
-    m = w * dim
-    f = np.zeros
-    # band, W, Z, A00, G, S, corner, small, rhs, tmp, X, V, Xhat, Vhat, spring block
-    return (f((p + 1, nt)), f((nt, m)), f((nt, m)), f((m, m)), f((m, m)), f((m, m)), f((m, m)), f((m, m + 1)),
-            f(nt), f(m), f((dim, nodes)), f((dim, nodes)), f((dim, nodes)), f((dim, nodes)), f((dim, dim)))
+Nodes = namedtuple("Nodes", ["free", "mass", "drag"])
+"""Per node: free (not held), mass [kg], linear drag b [kg/s] (0 at held nodes)."""
 
 
-# ----------------------------------------------------------------------------------- linear algebra
+class SdirkFamily(Integrator):
+    """The stiff family: SDIRK2 with a banded Newton solve per stage; ``stats[0]`` counts Newton iterations."""
 
+    STATE = ("stats",)
 
-@njit(cache=True, error_model="numpy")
-def _band_cholesky(band, p):
-    """In-place Cholesky of a symmetric positive definite band matrix stored as band[q, j] = A[j + q, j]."""
-    nt = band.shape[1]
-    for j in range(nt):
-        s = band[0, j]
-        for k in range(max(0, j - p), j):
-            lk = band[j - k, k]
-            s -= lk * lk
-        if not s > 0.0:
-            return False
-        djj = math.sqrt(s)
-        band[0, j] = djj
-        for i in range(j + 1, min(nt, j + p + 1)):
-            s = band[i - j, j]
-            for k in range(max(0, i - p), j):
-                s -= band[i - k, k] * band[j - k, k]
-            band[i - j, j] = s / djj
-    return True
+    def __init__(self, model, grid, method: Sdirk):
+        super().__init__(model, grid, method)
+        scene = model.scene
+        dim, n = model.dim, model.nodes
+        w, cyclic = band_width(scene.rope.closed, n, coupling_reach(scene))
+        nt, m = dim * n, w * dim
+        jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
+        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, NEWTON_TOL * scene.rope.segment_length)
+        shape = (dim, n)
+        self.stage = Stage(*(np.zeros(shape) for _ in Stage._fields))
+        self.nodes = Nodes(np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag))
+        self.stats = np.zeros(1, dtype=np.int64)
+
+    @property
+    def force_evaluations(self) -> int:
+        """Newton iterations so far."""
+        return int(self.stats[0])
+
+    def _run(self, n, frames):
+        return advance_sdirk((self.x, self.v, self.ledger, self.stats), self.stage, self.newton, self.held,
+                             self.nodes, self.model.params, self.limits, self.schedule(n), frames)
 
 
 @njit(cache=True, error_model="numpy")
-def _band_solve(band, p, r):
-    """Solve L L^T z = r in place (``band`` holds L from :func:`_band_cholesky`)."""
-    nt = band.shape[1]
-    for i in range(nt):
-        s = r[i]
-        for k in range(max(0, i - p), i):
-            s -= band[i - k, k] * r[k]
-        r[i] = s / band[0, i]
-    for i in range(nt - 1, -1, -1):
-        s = r[i]
-        for k in range(i + 1, min(nt, i + p + 1)):
-            s -= band[k - i, i] * r[k]
-        r[i] = s / band[0, i]
-
-
-@njit(cache=True, error_model="numpy")
-def _band_solve_columns(band, p, z):
-    """Solve L L^T Z = z in place for every column of ``z`` (nt, m) at once: the same operations, in the same
-    order, as :func:`_band_solve` on each column, with each entry of L loaded once for all columns."""
-    nt, m = z.shape
-    for i in range(nt):
-        for k in range(max(0, i - p), i):
-            lik = band[i - k, k]
-            for c in range(m):
-                z[i, c] -= lik * z[k, c]
-        for c in range(m):
-            z[i, c] /= band[0, i]
-    for i in range(nt - 1, -1, -1):
-        for k in range(i + 1, min(nt, i + p + 1)):
-            lki = band[k - i, i]
-            for c in range(m):
-                z[i, c] -= lki * z[k, c]
-        for c in range(m):
-            z[i, c] /= band[0, i]
-
-
-@njit(cache=True, error_model="numpy")
-def _dense_solve(a, rhs, work):
-    """Solve a z = rhs (m x m, m x k) in place into ``rhs`` by Gaussian elimination with partial pivoting;
-    ``a`` is kept (``work`` is m x m+... scratch of at least m x m)."""
-    m = a.shape[0]
-    k = rhs.shape[1]
-    lu = work
-    for i in range(m):
-        for j in range(m):
-            lu[i, j] = a[i, j]
-    for col in range(m):
-        piv = col
-        for i in range(col + 1, m):
-            if abs(lu[i, col]) > abs(lu[piv, col]):
-                piv = i
-        if piv != col:
-            for j in range(m):
-                lu[col, j], lu[piv, j] = lu[piv, j], lu[col, j]
-            for j in range(k):
-                rhs[col, j], rhs[piv, j] = rhs[piv, j], rhs[col, j]
-        for i in range(col + 1, m):
-            f = lu[i, col] / lu[col, col]
-            for j in range(col, m):
-                lu[i, j] -= f * lu[col, j]
-            for j in range(k):
-                rhs[i, j] -= f * rhs[col, j]
-    for col in range(m - 1, -1, -1):
-        for j in range(k):
-            s = rhs[col, j]
-            for i in range(col + 1, m):
-                s -= lu[col, i] * rhs[i, j]
-            rhs[col, j] = s / lu[col, col]
-
-
-# ------------------------------------------------------------------------------------------ Jacobian
-
-
-@njit(cache=True, error_model="numpy")
-def _slot(n, dim, w, ni, nj, di, dj):
-    """Where A[ni*D+di, nj*D+dj] is kept: (0, q, c) for band[q, c], (1, row, c) for the wrap-around's
-    corner[row, c], (-1, 0, 0) above the diagonal (only the lower triangle is stored).
-
-    Indices only: a helper that took the arrays would cost an atomic reference-count update per array and
-    call; twelve such calls per spring made assembly ten times slower (366 ns per node against 35).
-    """
-    r = ni * dim + di
-    c = nj * dim + dj
-    if r < c:
-        return -1, 0, 0
-    if ni - nj <= w:
-        return 0, r - c, c
-    return 1, (ni - (n - w)) * dim + di, c
-
-
-@njit(cache=True, error_model="numpy")
-def _add_pair(band, corner, n, dim, w, i, j, blk, free_i, free_j):
-    """Add a spring's stiffness block: +blk to (i, i) and (j, j), -blk to (i, j) and (j, i)."""
-    hi, lo = (i, j) if i > j else (j, i)
-    free_hi, free_lo = (free_i, free_j) if i > j else (free_j, free_i)
-    for ni, nj, sign, used in ((hi, hi, 1.0, free_hi), (lo, lo, 1.0, free_lo), (hi, lo, -1.0, free_hi and free_lo)):
-        if not used:
-            continue
-        for a in range(dim):
-            for b in range(dim):
-                where, q, c = _slot(n, dim, w, ni, nj, a, b)
-                if where == 0:
-                    band[q, c] += sign * blk[a, b]
-                elif where == 1:
-                    corner[q, c] += sign * blk[a, b]
-
-
-@njit(cache=True, error_model="numpy")
-def _spring_blocks(x, band, corner, n, dim, w, k, rest, stride, closed, scale, free, blk):
-    count = n if closed else n - stride
-    for i in range(count):
-        j = i + stride
-        if j >= n:
-            j -= n
-        if i == j or not (free[i] or free[j]):
-            continue
-        r2 = 0.0
-        for d in range(dim):
-            delta = x[d, j] - x[d, i]
-            r2 += delta * delta
-        if r2 == 0.0:
-            continue
-        r = math.sqrt(r2)
-        geo = max(0.0, 1.0 - rest / r)   # compressive (negative) geometric stiffness left out: SPD
-        u = ((x[0, j] - x[0, i]) / r, (x[1, j] - x[1, i]) / r, (x[2, j] - x[2, i]) / r if dim == 3 else 0.0)
-        for a in range(dim):
-            for b in range(dim):
-                blk[a, b] = scale * k * ((1.0 - geo) * u[a] * u[b] + (geo if a == b else 0.0))
-        _add_pair(band, corner, n, dim, w, i, j, blk, free[i], free[j])
-
-
-@njit(cache=True, error_model="numpy")
-def _assemble(x, v, band, corner, beta, mass, drag, free, forces, w, blk):
-    """The Newton matrix M (1 + beta gamma) + beta^2 H + beta C_v into ``band`` (and ``corner``)."""
-    inv_mass, flags, spring, bending, gravity, thrower, guides = forces
-    dim, n = x.shape
-    box = box_of(thrower)
+def assemble(X, V, jac, beta, nodes, params):
+    """The Newton matrix M (1 + beta gamma) + beta^2 H + beta C_v into ``jac`` (see the module doc)."""
+    free, mass, drag = nodes
+    band, corner = jac.band, jac.corner
+    dim, n = X.shape
     band[:] = 0.0
     corner[:] = 0.0
-    closed = spring[2] != 0.0
-    b2 = beta * beta
-    _spring_blocks(x, band, corner, n, dim, w, spring[0], spring[1], 1, closed, b2, free, blk)
-    if flags[BENDING]:
-        _spring_blocks(x, band, corner, n, dim, w, bending[0], bending[1], 2, closed, b2, free, blk)
+    coupling_jacobian(X, jac, beta * beta, free, params)
     for i in range(n):
         if not free[i]:
             for d in range(dim):
@@ -267,126 +137,20 @@ def _assemble(x, v, band, corner, beta, mass, drag, free, forces, w, blk):
                 for e in range(d + 1, dim):
                     band[e - d, i * dim + d] = 0.0
             continue
-        m = mass[i]
-        diag = m + beta * drag[i]
+        diag = mass[i] + beta * drag[i]
         for d in range(dim):
             band[0, i * dim + d] += diag
-        outside = 1.0
-        if flags[THROWER]:
-            sb = weight_at(x[0, i], x[1, i], x[2, i] if dim == 3 else 0.0, dim == 3, box)
-            outside = 1.0 - sb
-            if sb > 0.0:
-                band[0, i * dim] += sb * beta * thrower[6]
-                for d in range(1, dim):
-                    band[0, i * dim + d] += sb * m * (b2 * thrower[7] + beta * thrower[8])
-        if flags[GUIDES] and outside > 0.0:
-            for c in range(guides.shape[0]):
-                dx = x[0, i] - guides[c, 0]
-                dy = x[1, i] - guides[c, 1]
-                r = math.sqrt(dx * dx + dy * dy)
-                radius = guides[c, 2]
-                weight = outside * smooth_step(radius - r, guides[c, 6])
-                if weight == 0.0 or r == 0.0:
-                    continue
-                ux, uy = dx / r, dy / r
-                vr = v[0, i] * ux + v[1, i] * uy
-                if guides[c, 5] != 0.0:
-                    if guides[c, 6] == 0.0:
-                        if vr > 0.0:
-                            continue
-                    else:
-                        weight *= smooth_step(-vr, guides[c, 6] * math.sqrt(guides[c, 3]))
-                ar = -guides[c, 3] * (r - radius) - guides[c, 4] * vr
-                radial = weight * (b2 * guides[c, 3] + beta * guides[c, 4])
-                tangential = weight * b2 * max(0.0, -ar / r)
-                u = (ux, uy)
-                for a in range(2):
-                    for b in range(a + 1):
-                        val = m * (radial * u[a] * u[b] + tangential * ((1.0 if a == b else 0.0) - u[a] * u[b]))
-                        band[a - b, i * dim + b] += val
+    node_jacobian(X, V, band, beta, mass, free, params)
 
 
 @njit(cache=True, error_model="numpy")
-def _factor(band, corner, cyclic, p, work):
-    """Factor the Newton matrix; with a wrap-around, prepare the Woodbury correction (see the module doc).
-
-    With C = A[first m rows, last m columns] (``corner`` holds C^T) and Gamma = -A00 (the top-left m x m
-    block): A = B + W Gamma W^T with W = [I; 0; X], X = -(A00^-1 C)^T, and B banded (its top-left block is
-    2 A00 and its bottom-right gains C^T A00^-1 C, both still positive definite). Then
-    A^-1 r = B^-1 r - Z S^-1 W^T B^-1 r with Z = B^-1 W and S = -A00^-1 + W^T Z.
-    """
-    wmat, zmat, a00, g, s, small = work[1], work[2], work[3], work[4], work[5], work[7]
-    nt = band.shape[1]
-    m = a00.shape[0]
-    if cyclic:
-        for a in range(m):
-            for b in range(m):
-                r, c = (a, b) if a >= b else (b, a)
-                a00[a, b] = band[r - c, c]
-                g[a, b] = corner[b, a]
-        _dense_solve(a00, g, small)              # G = A00^-1 C
-        for a in range(m):
-            for b in range(a + 1):
-                band[a - b, b] += a00[a, b]
-                val = 0.0
-                for q in range(m):
-                    val += corner[a, q] * g[q, b]
-                band[a - b, nt - m + b] += val
-    if not _band_cholesky(band, p):
-        return False
-    if cyclic:
-        wmat[:] = 0.0
-        for a in range(m):
-            wmat[a, a] = 1.0
-            for b in range(m):
-                wmat[nt - m + a, b] = -g[b, a]
-        zmat[:] = wmat
-        _band_solve_columns(band, p, zmat)
-        for b in range(m):
-            for a in range(m):
-                s[a, b] = 0.0
-            s[b, b] = -1.0
-        _dense_solve(a00, s, small)              # S = -A00^-1 ...
-        for a in range(m):
-            for b in range(m):
-                val = 0.0
-                for r in range(nt):
-                    val += wmat[r, a] * zmat[r, b]
-                s[a, b] += val                   # ... + W^T Z
-    return True
-
-
-@njit(cache=True, error_model="numpy")
-def _solve(band, cyclic, p, rhs, work):
-    """Solve the factored Newton system in place into ``rhs`` (flat, node-major)."""
-    wmat, zmat, s, corner, small, tmp = work[1], work[2], work[5], work[6], work[7], work[9]
-    nt = band.shape[1]
-    _band_solve(band, p, rhs)
-    if cyclic:
-        m = s.shape[0]
-        for a in range(m):
-            val = 0.0
-            for r in range(nt):
-                val += wmat[r, a] * rhs[r]
-            corner[a, 0] = val                   # corner is free once factored: W^T y, then S^-1 W^T y
-            for b in range(1, m):
-                corner[a, b] = 0.0
-        _dense_solve(s, corner, small)
-        for a in range(m):
-            tmp[a] = corner[a, 0]
-        for r in range(nt):
-            val = 0.0
-            for a in range(m):
-                val += zmat[r, a] * tmp[a]
-            rhs[r] -= val
-
-
-@njit(cache=True, error_model="numpy")
-def _solve_stage(xh, vh, X, V, acc, beta, t_stage, held, free, mass, drag, forces, w, cyclic, tol, work, blk):
+def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     """Newton solve of one stage: X = xh + beta V, V = vh + beta (a(X, V) - gamma V). Returns
     (iterations, node): iterations < 0 when it failed, naming the node that moved most in the last one."""
+    xh, vh, X, V, acc, _ = stage
     held_idx, held_x0, held_v = held
-    band, corner, rhs = work[0], work[6], work[8]
+    free, mass, drag = nodes
+    band, rhs = newton.jac.band, newton.rhs
     dim, n = X.shape
     p = band.shape[0] - 1
     for d in range(dim):
@@ -401,7 +165,7 @@ def _solve_stage(xh, vh, X, V, acc, beta, t_stage, held, free, mass, drag, force
         for j in range(held_idx.shape[0]):
             for d in range(dim):
                 V[d, held_idx[j]] = held_v[d, j]
-        accelerations(X, V, acc, forces)
+        accelerations(X, V, acc, params)
         for i in range(n):
             for d in range(dim):
                 u = i * dim + d
@@ -411,10 +175,10 @@ def _solve_stage(xh, vh, X, V, acc, beta, t_stage, held, free, mass, drag, force
                                - beta * beta * m * acc[d, i])
                 else:
                     rhs[u] = 0.0
-        _assemble(X, V, band, corner, beta, mass, drag, free, forces, w, blk)
-        if not _factor(band, corner, cyclic, p, work):
+        assemble(X, V, newton.jac, beta, nodes, params)
+        if not factor(band, newton.jac.corner, newton.cyclic, p, newton.wood):
             return -1, 0
-        _solve(band, cyclic, p, rhs, work)
+        solve(band, newton.jac.corner, newton.cyclic, p, rhs, newton.wood)
         worst = 0.0
         for i in range(n):
             for d in range(dim):
@@ -423,7 +187,7 @@ def _solve_stage(xh, vh, X, V, acc, beta, t_stage, held, free, mass, drag, force
                 if not abs(dx) <= worst:
                     worst = abs(dx)
                     worst_node = i
-        if worst <= tol:
+        if worst <= newton.tol:
             for d in range(dim):
                 for i in range(n):
                     if free[i]:
@@ -433,33 +197,35 @@ def _solve_stage(xh, vh, X, V, acc, beta, t_stage, held, free, mass, drag, force
 
 
 @njit(cache=True, error_model="numpy")
-def advance_sdirk(x, v, acc, acc_box, ledger, stats, step0, n_steps, total_steps, h, w, cyclic, tol, held, free,
-                  mass, drag, forces, limits, save_every, frames, check_every, work):
-    """Advance ``n_steps`` SDIRK2 steps in place; arguments and result as for
-    :func:`ropesim.integrators.advance`. ``stats[0]`` counts Newton iterations (force evaluations)."""
-    dim, n = x.shape
+def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, frames):
+    """Advance ``schedule.n_steps`` SDIRK2 steps in place; the contract of :mod:`ropesim.integrate.base`.
+
+    ``state`` = (x, v, ledger, stats), ``stats[0]`` counting Newton iterations (force evaluations). Returns
+    (steps done, frames written, status, node).
+    """
+    x, v, ledger, stats = state
+    xh, vh, X, V, acc, acc_box = stage
     held_idx, held_x0, held_v = held
-    flags = forces[1]
-    has_box = flags[THROWER] != 0 or flags[GUIDES] != 0
-    X, V, xh, vh = work[10], work[11], work[12], work[13]
-    blk = work[14]
+    free, mass, drag = nodes
+    h = schedule.h
+    dim, n = x.shape
+    has_box = any_applied(params.flags)
     beta = GAMMA * h
     frame = 0
-    for s in range(n_steps):
-        step = step0 + s
+    for s in range(schedule.n_steps):
+        step = schedule.step0 + s
         t = step * h
         for d in range(dim):
             for i in range(n):
                 xh[d, i] = x[d, i]
                 vh[d, i] = v[d, i]
-        for stage in range(2):
-            t_stage = t + (GAMMA if stage == 0 else 1.0) * h
-            its, node = _solve_stage(xh, vh, X, V, acc, beta, t_stage, held, free, mass, drag, forces, w, cyclic,
-                                     tol, work, blk)
+        for k in range(2):
+            t_stage = t + (GAMMA if k == 0 else 1.0) * h
+            its, node = solve_stage(stage, newton, beta, t_stage, held, nodes, params)
             if its < 0:
                 return s, frame, NEWTON_FAILED, node
             stats[0] += its
-            weight = (1.0 - GAMMA if stage == 0 else GAMMA) * h
+            weight = (1.0 - GAMMA if k == 0 else GAMMA) * h
             lost = 0.0
             for d in range(dim):
                 for i in range(n):
@@ -467,9 +233,9 @@ def advance_sdirk(x, v, acc, acc_box, ledger, stats, step0, n_steps, total_steps
             ledger[DRAG] += weight * lost
             ledger[HELD] += weight * held_power(acc, mass, held_idx, held_v)
             if has_box:
-                box_accelerations(X, V, acc_box, forces)
+                applied_accelerations(X, V, acc_box, params)
                 ledger[BOX] += weight * power(acc_box, V, mass)
-            if stage == 0:
+            if k == 0:
                 ratio = (1.0 - GAMMA) / GAMMA
                 for d in range(dim):
                     for i in range(n):
@@ -481,10 +247,9 @@ def advance_sdirk(x, v, acc, acc_box, ledger, stats, step0, n_steps, total_steps
                 v[d, i] = V[d, i]
         place_held(x, held_idx, held_x0, held_v, (step + 1) * h)
         done = step + 1
-        if done % check_every and done % save_every and done != total_steps:
+        if not due(done, schedule):
             continue  # nothing due: skip the call, whose array arguments cost more than a small rope's step
-        status, node, frame = end_step(done, total_steps, save_every, check_every, h, x, v, mass, forces, ledger,
-                                       limits, frames, frame)
+        status, node, frame = end_step(done, schedule, x, v, mass, params, ledger, limits, frames, frame)
         if status != OK:
             return s + 1, frame, status, node
-    return n_steps, frame, OK, -1
+    return schedule.n_steps, frame, OK, -1

@@ -1,11 +1,6 @@
-"""Time integrators, chosen by name: splitting schemes as data, a Butcher-table loop, and a stiff solver.
+"""Splitting (drift-kick) schemes: the methods as data, and the one compiled loop that runs them all.
 
-Every method advances the state (x, v), each of shape (D, N), by uniform steps h, keeps held (pinned or driven)
-nodes exactly on x0 + V t at every stage, keeps its order with linear drag on, and books the energy ledger
-(see :mod:`ropesim.health`). :data:`METHODS` maps each name to its method; the name is the same in TOML
-(``integrator.method``), on the command line and here.
-
-Splitting (drift-kick) schemes advance one step h as
+A scheme advances one step h as
 
     drift(a_0 h), kick(b_0 h), drift(a_1 h), kick(b_1 h), ..., kick(b_{s-1} h), drift(a_s h)
 
@@ -15,38 +10,36 @@ force sees positions of one instant. Linear drag is integrated exactly within ea
 the kick solves v' = a - gamma v for a time c, v <- e^(-gamma c) v + (1 - e^(-gamma c)) / gamma a. Putting
 -b v into a plain kick instead would drop every scheme to first order; done this way each keeps its order
 with drag on and drag never limits the time step. The thrower's and guides' forces are linear in velocity too:
-with their edges smoothed (``edge_width`` > 0) the nodes they touch get the exact kick of :mod:`ropesim.contact`;
-with sharp edges they stay in the plain kick (an explicit Euler step in v: first order, as before).
+with their edges smoothed (``edge_width`` > 0) the nodes they touch get the exact kick of
+:mod:`ropesim.integrate.contact`; with sharp edges they stay in the plain kick (an explicit Euler step in v:
+first order, as before).
 
-:func:`advance` below runs every splitting scheme on every scene. A 2-D rope with nothing but its own springs,
-gravity and drag (the towed ropes) runs instead on :func:`ropesim.chain.advance_chain`, the same steps written
-for that scene alone, with bit-identical trajectories.
-
-To add a method: give a splitting scheme's coefficients (or a Runge-Kutta method's Butcher table, see
-:mod:`ropesim.rk`), its order and a line of documentation, and list it in :data:`METHODS`; its stability
-interval is computed from the coefficients by :func:`stable_step`.
+:func:`advance_splitting` runs every scheme on every scene. Each kick stage takes one of two forms, chosen
+once per model: the general stage (every force through the term list, :func:`ropesim.model.terms.accelerations`)
+or, for a 2-D rope whose only forces are its springs and gravity, the plain stage of
+:mod:`ropesim.integrate.plain`, written for that physics alone; trajectories are bit-identical either way.
+Everything around the stages (drifts, held nodes, the step and frame schedule, the blow-up check) is shared.
 """
 
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 from numba import njit
 
-from .health import BOX, DRAG, HELD, NON_FINITE, OK, end_step, held_power, place_held  # noqa: F401
+from ..model.terms import GRAVITY, accelerations, applied_accelerations, mechanical_energy
+from .base import Integrator, Method
 from .contact import exact_contact_kicks
-from ..model.forces.guides import add_guides
-from ..model.forces.springs import add_pair_springs, set_chain_springs
-from ..model.forces.thrower import add_thrower
-from ..model.terms import BENDING, GRAVITY, GUIDES, THROWER, box_accelerations
+from .health import BOX, DRAG, E0, HELD, OK, SCALE, balance_status, save_frame, verdict
 from .kick import box_work, kick_drift
+from .plain import BULK_FIXED, BULK_PER_STAGE, applies, chain_energy, inactive_bundle, plain_bundle, settle_drag
 
 
 @dataclass(frozen=True)
-class SplittingScheme:
+class SplittingScheme(Method):
     """A drift-kick composition: ``drift`` has one more entry than ``kick``."""
 
     name: str
@@ -55,6 +48,11 @@ class SplittingScheme:
     kick: tuple[float, ...]
     doc: str
     kind: str = "splitting"
+    exact_contact_kicks = True
+
+    @property
+    def family(self) -> type:
+        return Splitting
 
     @property
     def evaluations(self) -> int:
@@ -67,9 +65,8 @@ class SplittingScheme:
         return len(self.kick) > 1 and self.drift[0] == 0.0 and self.drift[-1] == 0.0
 
     @property
-    def stability_limit(self) -> float:
-        """Largest h omega for which the scheme stays bounded on a harmonic oscillator x'' = -omega^2 x."""
-        return stable_step(self, 1.0)
+    def backward_kicks(self) -> bool:
+        return min(self.kick) < 0.0
 
     def amplification(self, h: float, omega: float, gamma_force: float = 0.0, gamma_drag: float = 0.0):
         """One step's 2x2 map of (x, v) for x'' = -omega^2 x - gamma_force x' - gamma_drag x'.
@@ -85,40 +82,6 @@ class SplittingScheme:
             gain = -math.expm1(-gamma_drag * ch) / gamma_drag if gamma_drag > 0 else ch
             m = np.array([[1.0, 0.0], [-gain * omega * omega, decay - gain * gamma_force]]) @ m
         return np.array([[1.0, self.drift[-1] * h], [0.0, 1.0]]) @ m
-
-
-def _stable(method, h: float, omega: float, gamma_force: float, gamma_drag: float) -> bool:
-    try:
-        m = method.amplification(h, omega, gamma_force, gamma_drag)
-    except OverflowError:   # a backward kick's e^(gamma |c| h) beyond the float range: the kernel's factor is inf
-        return False
-    if not np.all(np.isfinite(m)):
-        return False
-    return bool(np.max(np.abs(np.linalg.eigvals(m))) <= 1.0 + 1e-9)
-
-
-@lru_cache(maxsize=4096)
-def stable_step(method, omega: float, gamma_force: float = 0.0, gamma_drag: float = 0.0) -> float:
-    """Largest step h [s] for which ``method`` stays bounded on x'' = -omega^2 x - (gamma_force + gamma_drag) x'.
-
-    ``gamma_force`` [1/s] is damping the method evaluates explicitly (the thrower's and guides'), ``gamma_drag``
-    [1/s] the scene's linear drag (exact inside the splitting schemes' kicks, explicit in Runge-Kutta).
-    Infinite for an unconditionally stable method or when nothing oscillates or damps.
-    """
-    if getattr(method, "unconditionally_stable", False):
-        return math.inf
-    rate = max(omega, gamma_force + (gamma_drag if method.kind == "rk" else 0.0))
-    if rate <= 0.0:
-        return math.inf
-    backward = method.kind == "splitting" and min(method.kick) < 0.0   # its backward kicks amplify by drag
-    h, factor = 1e-3 / max(rate, gamma_drag if backward else 0.0), 1.01
-    while h * rate < 20.0 and _stable(method, h * factor, omega, gamma_force, gamma_drag):
-        h *= factor
-    lo, hi = h, h * factor
-    for _ in range(50):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if _stable(method, mid, omega, gamma_force, gamma_drag) else (lo, mid)
-    return lo
 
 
 def _yoshida4() -> SplittingScheme:
@@ -138,33 +101,16 @@ def _pefrl() -> SplittingScheme:
         "evaluations per step, a wider stability interval and a far smaller error constant than Yoshida-4.")
 
 
-def _methods() -> dict:
-    from .sdirk import SDIRK2
-    from .rk import RK4
-
-    schemes = (
-        SplittingScheme("symplectic_euler", 1, (0.0, 1.0), (1.0,),
-                        "Symplectic Euler, the write-up's method: kick with the forces at x_n, then drift with "
-                        "the new velocity. First order, 1 force evaluation per step."),
-        SplittingScheme("verlet", 2, (0.0, 1.0, 0.0), (0.5, 0.5),
-                        "Velocity Verlet: half kick, drift, half kick. Second order, 1 force evaluation per step "
-                        "(the last kick's forces are reused by the next step's first)."),
-        _yoshida4(),
-        _pefrl(),
-        RK4,
-        SDIRK2,
-    )
-    return {s.name: s for s in schemes}
-
-
-METHODS: dict = _methods()
-
-
-def get_method(name: str):
-    try:
-        return METHODS[name]
-    except KeyError:
-        raise ValueError(f"unknown integrator {name!r}: allowed {', '.join(METHODS)}") from None
+SCHEMES = (
+    SplittingScheme("symplectic_euler", 1, (0.0, 1.0), (1.0,),
+                    "Symplectic Euler, the write-up's method: kick with the forces at x_n, then drift with the new "
+                    "velocity. First order, 1 force evaluation per step."),
+    SplittingScheme("verlet", 2, (0.0, 1.0, 0.0), (0.5, 0.5),
+                    "Velocity Verlet: half kick, drift, half kick. Second order, 1 force evaluation per step (the "
+                    "last kick's forces are reused by the next step's first)."),
+    _yoshida4(),
+    _pefrl(),
+)
 
 
 def kick_factors(scheme: SplittingScheme, h: float, drag: np.ndarray, mass: np.ndarray,
@@ -198,34 +144,97 @@ def kick_factors(scheme: SplittingScheme, h: float, drag: np.ndarray, mass: np.n
     return np.ascontiguousarray(decay), np.ascontiguousarray(gain), np.ascontiguousarray(travel)
 
 
-@njit(cache=True, error_model="numpy")
-def advance(x, v, acc, acc_box, have_acc, ledger, step0, n_steps, total_steps, h, drift, kick, decay, gain, travel,
-            reuse_force, held, mass, forces, limits, save_every, frames, check_every, contacts):
-    """Advance ``n_steps`` splitting steps in place, from global step ``step0`` (time step0 * h).
+# ------------------------------------------------------------------------------------------------ bundles
 
-    ``held`` = (indices, x0 (D, H), V (D, H)); ``frames`` = (t (F,), x (F, D, N), v (F, D, N), ledger (F, 3)).
-    Saves a frame after every global step s (1-based) with s % save_every == 0 or s == total_steps.
-    ``have_acc[0]`` carries the first-same-as-last forces between calls. ``contacts`` = (exact, free (N,) bool,
-    drag rate b/m (N,), scratch (D, N), scratch (N,) int64): with ``exact`` the nodes touching the box or a
-    circle get the exact kick of :mod:`ropesim.contact`. Returns (steps done, frames written, status, node):
-    see :func:`ropesim.health.check_health`.
+SplittingState = namedtuple("SplittingState", ["x", "v", "acc", "have_acc", "ledger", "spring_forces", "lost"])
+"""x, v (D, N); the general stage's accelerations (D, N) and the plain stage's spring forces (2, N + 1), carried
+between calls when the last kick's forces are reused (``have_acc[0]``); the ledger; the plain stage's
+per-node work (N,)."""
+
+Kicks = namedtuple("Kicks", ["drift", "kick", "decay", "gain", "travel", "reuse_force"])
+"""The scheme's drift and kick coefficients and the exact drag kick's factors (stages, N) per node."""
+
+General = namedtuple("General", ["acc_box", "has_box", "exact", "free", "gamma", "v_contact", "contact_nodes", "buf"])
+"""The general stage's scratch: the applied terms' accelerations (D, N) and whether any is on; the exact
+contact kicks (on or off, free nodes, drag rates b/m, their velocities (D, N) and node list); kick scratch."""
+
+
+class Splitting(Integrator):
+    """The splitting family: any :class:`SplittingScheme`, on the general or the plain stage (see the module doc)."""
+
+    STATE = ("acc", "have_acc", "spring_forces", "lost")
+
+    def __init__(self, model, grid, method: SplittingScheme, specialise: bool = True):
+        """``specialise=False`` keeps a plain rope on the general stage (the tests compare the two)."""
+        super().__init__(model, grid, method)
+        stages = len(method.kick)
+        self.reuse_force = method.reuses_last_force and not model.velocity_dependent
+        decay, gain, travel = kick_factors(method, grid.dt, model.drag, model.mass, model.held)
+        self.kicks = Kicks(np.array(method.drift), np.array(method.kick), decay, gain, travel, self.reuse_force)
+        plain = specialise and applies(model, method)
+        self.plain = plain_bundle(model, decay, gain, travel) if plain else inactive_bundle(stages)
+        self.acc = np.zeros_like(self.x)
+        self.have_acc = np.zeros(1, dtype=np.bool_)
+        self.spring_forces = np.zeros((2, model.nodes + 1) if plain else (2, 1))
+        self.lost = np.zeros(model.nodes if plain else 0)
+        self.general = General(np.zeros_like(self.x), model.velocity_dependent,
+                               model.smooth_contacts and model.velocity_dependent, np.ascontiguousarray(~model.held),
+                               np.where(model.held, 0.0, model.drag / model.mass), np.zeros_like(self.x),
+                               np.zeros(model.nodes, dtype=np.int64), np.empty(model.nodes))
+        self.bundle = SplittingState(self.x, self.v, self.acc, self.have_acc, self.ledger, self.spring_forces,
+                                     self.lost)
+
+    @property
+    def on_plain_stage(self) -> bool:
+        return bool(self.plain.active)
+
+    def set_exact_contacts(self, on: bool) -> None:
+        """Kick nodes touching the box or a circle exactly (``on``) or plainly, whatever the edges (for the
+        accuracy study; by default the kick is exact when the edges are smoothed)."""
+        self.general = self.general._replace(exact=bool(on) and self.model.velocity_dependent)
+
+    @property
+    def force_evaluations(self) -> int:
+        # velocity-dependent forces rule out reusing the last kick's forces
+        return self.step * (len(self.method.kick) - (1 if self.reuse_force else 0))
+
+    def _run(self, n, frames):
+        m = self.model
+        return advance_splitting(self.bundle, self.kicks, self.plain, self.general, self.held, m.mass, m.params,
+                                 self.limits, self.schedule(n), frames)
+
+
+@njit(cache=True, error_model="numpy")
+def advance_splitting(state, kicks, plain, general, held, mass, params, limits, schedule, frames):
+    """Advance ``schedule.n_steps`` splitting steps in place, from global step ``schedule.step0``.
+
+    The contract of :mod:`ropesim.integrate.base`; returns (steps done, frames written, status, node). Each
+    kick stage is the plain stage (``plain.active``: a 2-D rope with its springs and gravity alone; see
+    :mod:`ropesim.integrate.plain`) or the general one; both are written out here rather than called, because
+    a helper taking arrays costs an atomic reference-count update per array and call, more than a small rope's
+    whole step on the plain stage. That, and the plain stage's two copies of its kick (a flag tested inside
+    the loop would stop it vectorising), is what makes this function long.
     """
+    x, v, acc, have_acc, ledger, f, lost = state
+    drift, kick, decay_k, gain_k, travel_k, reuse_force = kicks
+    held_idx, held_x0, held_v = held
+    step0, n_steps, total_steps, h, save_every, check_every = schedule
     dim, n = x.shape
     stages = kick.shape[0]
-    held_idx, held_x0, held_v = held
-    inv_mass, flags, spring, bending, gravity, thrower, guides = forces
-    closed = spring[2] != 0.0
-    g = gravity[0] if flags[GRAVITY] else 0.0
-    stiffness, rest = spring[0], spring[1]
-    has_bending = flags[BENDING] != 0
-    has_thrower = flags[THROWER] != 0
-    has_guides = flags[GUIDES] != 0
-    has_box = has_thrower or has_guides
-    exact, free, gamma, v_contact, contact_nodes = contacts
-    exact = exact and has_box
     n_held = held_idx.shape[0]
-    buf = np.empty(n)   # kick_drift's per-node losses
+    inv_mass = params.inv_mass
+    g = params.gravity[0] if params.flags[GRAVITY] else 0.0
+    k_spring, rest, closed = params.spring[0], params.spring[1], params.spring[2] != 0.0
+    is_plain = plain.active
+    px, py, vx, vy, fx, fy = x[0], x[1], v[0], v[1], f[0], f[1]   # the plain stage's rows
+    inv_m = plain.bulk[0]
+    n_exc = plain.exceptions.shape[0]
+    if is_plain and not closed:
+        fx[0] = fx[n] = fy[0] = fy[n] = 0.0
+    held_work = ledger[HELD]   # kept in a register, stored whenever the ledger is read
     frame = 0
+    next_check = step0 + check_every - step0 % check_every   # counted, not divided, per step
+    next_save = step0 + save_every - step0 % save_every
     for s in range(n_steps):
         step = step0 + s
         t = step * h
@@ -235,60 +244,159 @@ def advance(x, v, acc, acc_box, have_acc, ledger, step0, n_steps, total_steps, h
                 for i in range(n):
                     x[d, i] += ch * v[d, i]
             t += ch
-            place_held(x, held_idx, held_x0, held_v, t)
-        for k in range(stages):
-            if not (k == 0 and reuse_force and have_acc[0]):   # accelerations(), its force tuple unpacked once
-                set_chain_springs(x, acc, inv_mass, stiffness, rest, closed, g)
-                if has_bending:
-                    add_pair_springs(x, acc, inv_mass, bending[0], bending[1], 2, closed)
-                if has_thrower:
-                    add_thrower(x, v, acc, inv_mass, thrower, g)
-                if has_guides:
-                    add_guides(x, v, acc, guides, thrower, has_thrower, g)
-            box = 0.0
-            if has_box:
-                box_accelerations(x, v, acc_box, forces)
-                box = box_work(v, acc, acc_box, gain, travel, k, mass)   # from the velocities before the kick
-            touching = 0
-            if exact:
-                touching = exact_contact_kicks(x, v, acc, v_contact, contact_nodes, kick[k] * h, gamma, free, forces)
-            drifting = drift[k + 1] != 0.0
-            ch = drift[k + 1] * h
-            # the kick, the loss it books (from the velocities before it) and the next drift, fused; a contact
-            # kick replaces some velocities first, so then the drift runs on its own
-            lost = kick_drift(x, v, acc, decay, gain, travel, k, mass, ch if drifting and touching == 0 else 0.0,
-                              buf)
-            for j in range(touching):
-                i = contact_nodes[j]
-                for d in range(dim):
-                    v[d, i] = v_contact[d, i]
-            if drifting and touching != 0:
-                for d in range(dim):
-                    for i in range(n):
-                        x[d, i] += ch * v[d, i]
-            ck = kick[k] * h
-            ledger[DRAG] += lost
-            p = 0.0   # held_power(): the supports' power on the rope
-            for j in range(n_held):
+            for j in range(n_held):   # health.place_held, written out: the call cost 2.5 % at N = 21
                 i = held_idx[j]
                 for d in range(dim):
-                    p -= mass[i] * acc[d, i] * held_v[d, j]
-            ledger[HELD] += ck * p
-            if has_box:
+                    x[d, i] = held_x0[d, j] + held_v[d, j] * t
+        for st in range(stages):
+            ch = drift[st + 1] * h
+            fresh = not (st == 0 and reuse_force and have_acc[0])
+            p = 0.0   # the supports' power on the rope: a held node does not accelerate, so its support pushes -m a
+            if is_plain:
+                # ---- the plain stage: spring forces into f, then the bulk kick and drift from them
+                if fresh:
+                    for i in range(n - 1):
+                        d0 = px[i + 1] - px[i]
+                        d1 = py[i + 1] - py[i]
+                        r2 = d0 * d0 + d1 * d1
+                        c = k_spring * (1.0 - rest / np.sqrt(r2)) if r2 > 0.0 else 0.0   # no direction, no force
+                        fx[i + 1] = c * d0
+                        fy[i + 1] = c * d1
+                    if closed:   # an open line's f[:, 0] and f[:, N] stay 0
+                        d0 = px[0] - px[n - 1]
+                        d1 = py[0] - py[n - 1]
+                        r2 = d0 * d0 + d1 * d1
+                        c = k_spring * (1.0 - rest / np.sqrt(r2)) if r2 > 0.0 else 0.0
+                        fx[0] = fx[n] = c * d0
+                        fy[0] = fy[n] = c * d1
+                b = BULK_FIXED + BULK_PER_STAGE * st
+                decay, gain, reach = plain.bulk[b], plain.bulk[b + 1], plain.bulk[b + 2]
+                for j in range(n_exc):
+                    i = plain.exceptions[j]
+                    plain.saved_x[0, j] = px[i]
+                    plain.saved_x[1, j] = py[i]
+                    plain.saved_v[0, j] = vx[i]
+                    plain.saved_v[1, j] = vy[i]
+                    plain.saved_lost[j] = lost[i]
+                if plain.has_drag:
+                    for i in range(n):
+                        ax = (fx[i + 1] - fx[i]) * inv_m
+                        ay = (fy[i + 1] - fy[i]) * inv_m - g
+                        ux = vx[i]
+                        uy = vy[i]
+                        gx = gain * ax
+                        gy = gain * ay
+                        wx = decay * ux + gx
+                        wy = decay * uy + gy
+                        lost[i] += (ux + reach * ax) * gx + (uy + reach * ay) * gy
+                        vx[i] = wx
+                        vy[i] = wy
+                        px[i] += ch * wx
+                        py[i] += ch * wy
+                else:
+                    for i in range(n):
+                        ax = (fx[i + 1] - fx[i]) * inv_m
+                        ay = (fy[i + 1] - fy[i]) * inv_m - g
+                        wx = decay * vx[i] + gain * ax
+                        wy = decay * vy[i] + gain * ay
+                        vx[i] = wx
+                        vy[i] = wy
+                        px[i] += ch * wx
+                        py[i] += ch * wy
+                for j in range(n_exc):   # the exceptions, redone from their saved state with their own factors
+                    i = plain.exceptions[j]
+                    e_decay = plain.exception_factors[st, 0, j]
+                    e_gain = plain.exception_factors[st, 1, j]
+                    e_reach = plain.exception_factors[st, 2, j]
+                    ax = (fx[i + 1] - fx[i]) * inv_mass[i]
+                    ay = (fy[i + 1] - fy[i]) * inv_mass[i] - g
+                    ux = plain.saved_v[0, j]
+                    uy = plain.saved_v[1, j]
+                    gx = e_gain * ax
+                    gy = e_gain * ay
+                    wx = e_decay * ux + gx
+                    wy = e_decay * uy + gy
+                    vx[i] = wx
+                    vy[i] = wy
+                    px[i] = plain.saved_x[0, j] + ch * wx
+                    py[i] = plain.saved_x[1, j] + ch * wy
+                    lost[i] = plain.saved_lost[j]
+                    if plain.has_drag:
+                        lost[i] += (ux + e_reach * ax) * gx + (uy + e_reach * ay) * gy
+                for j in range(n_held):   # held nodes: their power, and the velocity their bulk kick changed
+                    i = held_idx[j]
+                    ax = (fx[i + 1] - fx[i]) * inv_mass[i]
+                    ay = (fy[i + 1] - fy[i]) * inv_mass[i] - g
+                    p -= mass[i] * ax * held_v[0, j]
+                    p -= mass[i] * ay * held_v[1, j]
+                    vx[i] = held_v[0, j]
+                    vy[i] = held_v[1, j]
+            else:
+                # ---- the general stage: every term through the term list, the kick and its ledger per node
+                if fresh:
+                    accelerations(x, v, acc, params)
+                box = 0.0
+                if general.has_box:
+                    applied_accelerations(x, v, general.acc_box, params)
+                    box = box_work(v, acc, general.acc_box, gain_k, travel_k, st, mass)   # from velocities before
+                touching = 0
+                if general.exact:
+                    touching = exact_contact_kicks(x, v, acc, general.v_contact, general.contact_nodes,
+                                                   kick[st] * h, general.gamma, general.free, params)
+                # the kick, the loss it books and the next drift, fused; a contact kick replaces some
+                # velocities first, so then the drift runs on its own
+                ledger[DRAG] += kick_drift(x, v, acc, decay_k, gain_k, travel_k, st, mass,
+                                           ch if touching == 0 else 0.0, general.buf)
+                for j in range(touching):
+                    i = general.contact_nodes[j]
+                    for d in range(dim):
+                        v[d, i] = general.v_contact[d, i]
+                if ch != 0.0 and touching != 0:
+                    for d in range(dim):
+                        for i in range(n):
+                            x[d, i] += ch * v[d, i]
+                for j in range(n_held):   # health.held_power, written out
+                    i = held_idx[j]
+                    for d in range(dim):
+                        p -= mass[i] * acc[d, i] * held_v[d, j]
+                if general.has_box:
+                    for j in range(n_held):
+                        i = held_idx[j]
+                        for d in range(dim):
+                            box += kick[st] * h * mass[i] * general.acc_box[d, i] * held_v[d, j]
+                    ledger[BOX] += box
+            held_work += kick[st] * h * p
+            if ch != 0.0:
+                t += ch
                 for j in range(n_held):
                     i = held_idx[j]
                     for d in range(dim):
-                        box += ck * mass[i] * acc_box[d, i] * held_v[d, j]
-                ledger[BOX] += box
-            if drifting:
-                t += ch
-                place_held(x, held_idx, held_x0, held_v, t)
+                        x[d, i] = held_x0[d, j] + held_v[d, j] * t
         have_acc[0] = reuse_force
         done = step + 1
-        if done % check_every and done % save_every and done != total_steps:
-            continue  # nothing due: skip the call, whose array arguments cost more than a small rope's step
-        status, node, frame = end_step(done, total_steps, save_every, check_every, h, x, v, mass, forces, ledger,
-                                       limits, frames, frame)
-        if status != OK:
-            return s + 1, frame, status, node
+        if done < next_check and done < next_save and done != total_steps:
+            continue
+        saving = done == next_save or done == total_steps
+        if done == next_check:
+            next_check += check_every
+        if done == next_save:
+            next_save += save_every
+        ledger[HELD] = held_work
+        if is_plain:
+            settle_drag(ledger, lost, v, plain.free_mass, plain.kinetic0, plain.has_drag, held_idx, plain.terms)
+            energy, stretch, worst = chain_energy(x, v, mass, k_spring, rest, closed, g, plain.lengths, plain.terms)
+        else:
+            energy, stretch, worst = mechanical_energy(x, v, mass, params)
+        status = balance_status(energy, stretch, held_work, ledger[BOX], ledger[DRAG], ledger[E0], ledger[SCALE],
+                                limits[0], limits[1], limits[2])
+        if status != OK or not np.isfinite(energy):   # only now hand the arrays over, to name the culprit
+            status, node = verdict(energy, stretch, worst, x, v, ledger, limits)
+            if status != OK:
+                return s + 1, frame, status, node
+        if saving:
+            save_frame(frame, done * h, x, v, ledger, frames.t, frames.x, frames.v, frames.ledger)
+            frame += 1
+    ledger[HELD] = held_work
+    if is_plain:
+        settle_drag(ledger, lost, v, plain.free_mass, plain.kinetic0, plain.has_drag, held_idx, plain.terms)
     return n_steps, frame, OK, -1

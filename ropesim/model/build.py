@@ -1,8 +1,8 @@
 """Turn a validated :class:`Scene` into the arrays the compiled kernel works on.
 
 Nothing here steps time: it lays out the initial state (shape (D, N), structure of arrays), the per-node
-masses and drag coefficients, the held (pinned or driven) nodes, and one parameter array plus an on/off flag
-per optional force term.
+masses and drag coefficients, the held (pinned or driven) nodes, and the force terms' parameters and flags
+(:func:`ropesim.model.terms.model_params`).
 """
 
 from __future__ import annotations
@@ -12,9 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..scene import schema as S
-from .forces.guides import GUIDE_PARAMS
-from .forces.thrower import THROWER_PARAMS
-from .terms import BENDING, GRAVITY, GUIDES, N_FLAGS, THROWER
+from .terms import ModelParams, has_applied, model_params
 
 
 @dataclass
@@ -25,12 +23,12 @@ class Model:
     x0: np.ndarray            # initial positions [m]
     v0: np.ndarray            # initial velocities [m/s]
     mass: np.ndarray          # (N,) [kg]
-    drag: np.ndarray          # (N,) drag coefficients b [kg/s]
+    drag: np.ndarray          # (N,) linear drag coefficients b [kg/s]
     held: np.ndarray          # (N,) bool: pinned or driven
     held_idx: np.ndarray      # (H,) int64 indices of held nodes
     held_x0: np.ndarray       # (D, H) their positions at t = 0 [m]
     held_v: np.ndarray        # (D, H) their constant velocities [m/s]
-    forces: tuple             # (inv_mass, flags, spring, bending, gravity, thrower, guides) for the kernel
+    params: ModelParams       # the force terms' parameters and flags, for the compiled code
 
     @property
     def dim(self) -> int:
@@ -43,12 +41,19 @@ class Model:
     @property
     def velocity_dependent(self) -> bool:
         """True when a force other than drag depends on velocity (the thrower and guide circles)."""
-        flags = self.forces[1]
-        return bool(flags[THROWER] or flags[GUIDES])
+        return has_applied(self.params)
 
     @property
     def has_drag(self) -> bool:
         return bool(np.any(self.drag[~self.held] > 0))
+
+    @property
+    def smooth_contacts(self) -> bool:
+        """True when the box's or a circle's edges are smoothed: the splitting schemes then kick the nodes they
+        touch exactly (:mod:`ropesim.integrate.contact`)."""
+        scene = self.scene
+        return (scene.thrower is not None and scene.thrower.edge_width > 0) or any(g.edge_width > 0
+                                                                                     for g in scene.guides)
 
 
 def build(scene: S.Scene) -> Model:
@@ -78,35 +83,9 @@ def build(scene: S.Scene) -> Model:
     held_idx = np.flatnonzero(held).astype(np.int64)
     v0[:, held_idx] = held_v[:, held_idx]
 
-    flags = np.zeros(N_FLAGS, dtype=np.uint8)
-    rope = scene.rope
-    spring = np.array([rope.stiffness, rope.segment_length, 1.0 if rope.closed else 0.0])
-    bending = np.zeros(2)
-    if scene.bending is not None:
-        flags[BENDING] = 1
-        bending = np.array([scene.bending.stiffness, 2.0 * rope.segment_length])
-    gravity = np.zeros(1)
-    if scene.gravity is not None:
-        flags[GRAVITY] = 1
-        gravity[0] = scene.gravity.g
-    thrower = np.zeros(THROWER_PARAMS)
-    if scene.thrower is not None:
-        flags[THROWER] = 1
-        t = scene.thrower
-        centre = list(t.center) + [0.0] * (3 - dim)
-        w = t.omega0
-        thrower = np.array([*centre, t.length / 2, t.width / 2, t.v_max, t.b_thrower, w * w,
-                            2 * t.damping_ratio * w, t.edge_width])
-    guides = np.zeros((0, GUIDE_PARAMS))
-    if scene.guides:
-        flags[GUIDES] = 1
-        guides = np.array([[c.center[0], c.center[1], c.radius, c.omega0 * c.omega0, 2 * c.damping_ratio * c.omega0,
-                            1.0 if c.one_sided else 0.0, c.edge_width] for c in scene.guides])
-
-    forces = (1.0 / mass, flags, spring, bending, gravity, thrower, guides)
     return Model(scene=scene, x0=x0, v0=v0, mass=mass, drag=drag, held=held, held_idx=held_idx,
                  held_x0=np.ascontiguousarray(x0[:, held_idx]), held_v=np.ascontiguousarray(held_v[:, held_idx]),
-                 forces=forces)
+                 params=model_params(scene, mass))
 
 
 def initial_positions(scene: S.Scene) -> np.ndarray:

@@ -14,7 +14,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..analysis.energy import energy_terms
+from ..model.energy import energy_terms
 from ..analysis.towed import exact_steady_state, segment_angles, shape_verdict, towed_end
 from ..model.build import Model, build
 from ..model.forces.springs import pair_spring_stretch

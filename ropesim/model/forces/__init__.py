@@ -1,6 +1,68 @@
-"""Force terms, one file each. Every term is a jitted kernel that *adds* its acceleration to ``acc``.
+"""Force terms, one file each, and the :class:`Term` record that tells the rest of ropesim about a term.
 
-State arrays are structure-of-arrays: ``x``, ``v`` and ``acc`` have shape (D, N), so each coordinate is
-contiguous. Linear air drag is not here: it is integrated exactly inside each velocity kick
-(see :mod:`ropesim.integrators`).
+Every term is a compiled kernel that *adds* its acceleration [m/s^2] to ``acc``. State arrays are
+structure-of-arrays: ``x``, ``v`` and ``acc`` have shape (D, N), so each coordinate is contiguous. The compiled
+term list that calls the kernels, each behind its flag, is :mod:`ropesim.model.terms`; the Python side of
+each term (its parameters, its energy, what it does to the stability bound) is its :class:`Term` record,
+listed in ``ropesim.model.terms.TERMS``. Adding a term is described in ``CONTRIBUTING.md``.
+
+Linear isotropic drag (``[drag]``, per-node b) is not a kernel here: each integrator family treats it itself,
+exactly inside the splitting schemes' kicks (see :mod:`ropesim.integrate.splitting`).
 """
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+
+
+def _none(*_args) -> None:
+    return None
+
+
+def _zero(*_args) -> float:
+    return 0.0
+
+
+@dataclass(frozen=True)
+class Term:
+    """What ropesim needs to know about one force term, besides its compiled kernel.
+
+    ``params(scene, mass)`` builds the term's parameters (a float64 array, or a tuple of arrays) for a scene
+    that declares the term, and ``empty`` is what an undeclared term gets instead: the same types, so every
+    scene compiles to one signature. The hooks, each optional:
+
+    - ``energy(model, x)``: a conservative term's potential energy [J] for frames x (..., N, D), as NumPy
+      (the analyses, the energy ledger's E(t) and the blow-up check's energy scale use it; the compiled check
+      uses :func:`ropesim.model.terms.mechanical_energy`, which must agree);
+    - ``springs(model)``: (stride, k [N/m]) pairs this term couples nodes with, for the stability bound's
+      stiffness Laplacian;
+    - ``node_stiffness(model)``: the largest omega^2 [1/s^2] the term adds to a single node (a centring spring);
+    - ``damping(model)``: the largest velocity-damping rate [1/s] the term applies, which explicit methods
+      must resolve;
+    - ``applied``: True for a non-conservative term whose work the ledger books in its ``box_work`` column
+      (its acceleration is part of :func:`ropesim.model.terms.applied_accelerations`);
+    - ``reach``: how many places along the rope the term couples nodes (0 for a node-local term), which sets
+      the stiff integrator's band width; its Jacobian blocks go in through
+      :func:`ropesim.model.terms.coupling_jacobian` (couplings) or :func:`ropesim.model.terms.node_jacobian`
+      (node-local blocks), see :mod:`ropesim.model.jacobian`.
+    """
+
+    name: str                                   # the scene's table (or array of tables) that declares it
+    flag: int | None                            # its index in ModelParams.flags; None: always on
+    params: Callable[[Any, np.ndarray], Any]
+    empty: Callable[[], Any]
+    energy: Callable | None = None
+    springs: Callable = _none
+    node_stiffness: Callable = _zero
+    damping: Callable = _zero
+    applied: bool = False
+    label: str = ""                             # its energy's name in energy_terms (default: ``name``)
+    reach: int = 0
+
+    def declared(self, scene) -> bool:
+        """True when ``scene`` declares this term (or the term is always on)."""
+        part = getattr(scene, self.name)
+        return self.flag is None or (part is not None and part != ())

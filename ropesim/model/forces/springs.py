@@ -8,6 +8,8 @@ pulls both ends along the segment with force k (r - l0) r_hat. On an open line t
 import numpy as np
 from numba import njit
 
+from . import Term
+
 
 @njit(cache=True, error_model="numpy")
 def add_pair_springs(x, acc, inv_mass, k, rest, stride, closed):
@@ -132,3 +134,27 @@ def pair_spring_energy(x, k, rest, stride, closed):
 def pair_spring_stretch(x, rest, stride, closed):
     """Relative stretch |r| / l0 - 1 of every spring (i, i + stride), for positions (..., N, D)."""
     return _by_blocks(lambda b: np.linalg.norm(_deltas(b, stride, closed), axis=-1) / rest - 1.0, x)
+
+
+def _rope_params(scene, mass) -> np.ndarray:
+    rope = scene.rope
+    return np.array([rope.stiffness, rope.segment_length, 1.0 if rope.closed else 0.0])
+
+
+def _bending_params(scene, mass) -> np.ndarray:
+    return np.array([scene.bending.stiffness, 2.0 * scene.rope.segment_length])
+
+
+ROPE = Term(
+    "rope", None, _rope_params, lambda: np.zeros(3),
+    energy=lambda model, x: pair_spring_energy(x, model.scene.rope.stiffness, model.scene.rope.segment_length, 1,
+                                               model.scene.rope.closed),
+    springs=lambda model: [(1, model.scene.rope.stiffness)], label="spring", reach=1)
+"""The rope's own springs (i, i + 1): parameters k [N/m], rest length l [m], closed (1) or open (0)."""
+
+BENDING = Term(
+    "bending", 0, _bending_params, lambda: np.zeros(2),
+    energy=lambda model, x: pair_spring_energy(x, model.scene.bending.stiffness, 2 * model.scene.rope.segment_length,
+                                               2, model.scene.rope.closed),
+    springs=lambda model: [(2, model.scene.bending.stiffness)], reach=2)
+"""Second-neighbour springs (i, i + 2), the seed's bending stiffness: parameters k2 [N/m], rest length 2 l [m]."""

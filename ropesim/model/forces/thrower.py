@@ -14,7 +14,10 @@ Parameters, packed in one float64 array: cx, cy, cz, L/2, W/2, v_max, b_thrower,
 
 import math
 
+import numpy as np
 from numba import njit
+
+from . import Term
 
 THROWER_PARAMS = 10
 SMOOTH_CUTOFF = 20.0  # beyond 20 widths tanh is 1 to double precision: the weight is exactly 0 or 1
@@ -93,3 +96,43 @@ def add_thrower(x, v, acc, inv_mass, p, g):
         acc[1, i] += s * (g - w2 * (x[1, i] - p[1]) - c * v[1, i])
         if x.shape[0] == 3:
             acc[2, i] += s * (-w2 * (x[2, i] - p[2]) - c * v[2, i])
+
+
+
+@njit(cache=True, error_model="numpy")
+def add_thrower_jacobian(x, band, beta, mass, free, p):
+    """Add the box's node blocks to the stiff integrator's Newton matrix (see :mod:`ropesim.model.jacobian`).
+
+    For a node inside the box (weight s): beta s b_thrower along x (the drive's damping, beta times
+    d force / d v) and s m (beta^2 omega0^2 + beta 2 zeta omega0) across (the centring spring and its damping).
+    """
+    dim, n = x.shape
+    three_d = dim == 3
+    box = box_of(p)
+    b2 = beta * beta
+    for i in range(n):
+        if not free[i]:
+            continue
+        sb = weight_at(x[0, i], x[1, i], x[2, i] if three_d else 0.0, three_d, box)
+        if sb > 0.0:
+            band[0, i * dim] += sb * beta * p[6]
+            for d in range(1, dim):
+                band[0, i * dim + d] += sb * mass[i] * (b2 * p[7] + beta * p[8])
+
+def _params(scene, mass) -> np.ndarray:
+    t = scene.thrower
+    centre = list(t.center) + [0.0] * (3 - scene.dimension)
+    w = t.omega0
+    return np.array([*centre, t.length / 2, t.width / 2, t.v_max, t.b_thrower, w * w, 2 * t.damping_ratio * w,
+                     t.edge_width])
+
+
+def _damping(model) -> float:
+    """The drive's b_thrower / m on the lightest free node, or the centring spring's 2 zeta omega0 [1/s]."""
+    t = model.scene.thrower
+    free_mass = model.mass[~model.held] if (~model.held).any() else model.mass
+    return max(t.b_thrower / float(free_mass.min()), 2 * t.damping_ratio * t.resolved_omega0)
+
+
+THROWER = Term("thrower", 2, _params, lambda: np.zeros(THROWER_PARAMS),
+               node_stiffness=lambda model: model.scene.thrower.resolved_omega0 * model.scene.thrower.resolved_omega0, damping=_damping, applied=True)

@@ -1,0 +1,191 @@
+"""Solves with the stiff integrator's Newton matrix: banded Cholesky, and a Woodbury correction for a loop.
+
+The matrix is symmetric positive definite and block banded (see :mod:`ropesim.model.jacobian` for its
+storage); :func:`factor` factors it in place in O(N) and :func:`solve` solves with the factors. On a closed
+loop the wrap-around couplings in ``corner`` are handled by a Woodbury correction of rank w D (:func:`factor`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+Woodbury = namedtuple("Woodbury", ["wmat", "zmat", "a00", "g", "s", "small", "tmp"])
+"""The wrap-around correction's arrays, m = w D: W and Z (N D, m), A00, G and S (m, m), dense-solve scratch
+(m, m + 1), a vector (m,). See :func:`factor`."""
+
+
+def woodbury(nt: int, m: int) -> Woodbury:
+    """Zeroed Woodbury arrays for a matrix of order ``nt`` and a correction of rank ``m``."""
+    f = np.zeros
+    return Woodbury(f((nt, m)), f((nt, m)), f((m, m)), f((m, m)), f((m, m)), f((m, m + 1)), f(m))
+
+
+@njit(cache=True, error_model="numpy")
+def band_cholesky(band, p):
+    """In-place Cholesky of a symmetric positive definite band matrix stored as band[q, j] = A[j + q, j]."""
+    nt = band.shape[1]
+    for j in range(nt):
+        s = band[0, j]
+        for k in range(max(0, j - p), j):
+            lk = band[j - k, k]
+            s -= lk * lk
+        if not s > 0.0:
+            return False
+        djj = math.sqrt(s)
+        band[0, j] = djj
+        for i in range(j + 1, min(nt, j + p + 1)):
+            s = band[i - j, j]
+            for k in range(max(0, i - p), j):
+                s -= band[i - k, k] * band[j - k, k]
+            band[i - j, j] = s / djj
+    return True
+
+
+@njit(cache=True, error_model="numpy")
+def band_solve(band, p, r):
+    """Solve L L^T z = r in place (``band`` holds L from :func:`_band_cholesky`)."""
+    nt = band.shape[1]
+    for i in range(nt):
+        s = r[i]
+        for k in range(max(0, i - p), i):
+            s -= band[i - k, k] * r[k]
+        r[i] = s / band[0, i]
+    for i in range(nt - 1, -1, -1):
+        s = r[i]
+        for k in range(i + 1, min(nt, i + p + 1)):
+            s -= band[k - i, i] * r[k]
+        r[i] = s / band[0, i]
+
+
+@njit(cache=True, error_model="numpy")
+def band_solve_columns(band, p, z):
+    """Solve L L^T Z = z in place for every column of ``z`` (nt, m) at once: the same operations, in the same
+    order, as :func:`band_solve` on each column, with each entry of L loaded once for all columns."""
+    nt, m = z.shape
+    for i in range(nt):
+        for k in range(max(0, i - p), i):
+            lik = band[i - k, k]
+            for c in range(m):
+                z[i, c] -= lik * z[k, c]
+        for c in range(m):
+            z[i, c] /= band[0, i]
+    for i in range(nt - 1, -1, -1):
+        for k in range(i + 1, min(nt, i + p + 1)):
+            lki = band[k - i, i]
+            for c in range(m):
+                z[i, c] -= lki * z[k, c]
+        for c in range(m):
+            z[i, c] /= band[0, i]
+
+
+@njit(cache=True, error_model="numpy")
+def dense_solve(a, rhs, work):
+    """Solve a z = rhs (m x m, m x k) in place into ``rhs`` by Gaussian elimination with partial pivoting;
+    ``a`` is kept (``work`` is m x m+... scratch of at least m x m)."""
+    m = a.shape[0]
+    k = rhs.shape[1]
+    lu = work
+    for i in range(m):
+        for j in range(m):
+            lu[i, j] = a[i, j]
+    for col in range(m):
+        piv = col
+        for i in range(col + 1, m):
+            if abs(lu[i, col]) > abs(lu[piv, col]):
+                piv = i
+        if piv != col:
+            for j in range(m):
+                lu[col, j], lu[piv, j] = lu[piv, j], lu[col, j]
+            for j in range(k):
+                rhs[col, j], rhs[piv, j] = rhs[piv, j], rhs[col, j]
+        for i in range(col + 1, m):
+            f = lu[i, col] / lu[col, col]
+            for j in range(col, m):
+                lu[i, j] -= f * lu[col, j]
+            for j in range(k):
+                rhs[i, j] -= f * rhs[col, j]
+    for col in range(m - 1, -1, -1):
+        for j in range(k):
+            s = rhs[col, j]
+            for i in range(col + 1, m):
+                s -= lu[col, i] * rhs[i, j]
+            rhs[col, j] = s / lu[col, col]
+
+
+@njit(cache=True, error_model="numpy")
+def factor(band, corner, cyclic, p, wood):
+    """Factor the Newton matrix; with a wrap-around, prepare the Woodbury correction (see the module doc).
+
+    With C = A[first m rows, last m columns] (``corner`` holds C^T) and Gamma = -A00 (the top-left m x m
+    block): A = B + W Gamma W^T with W = [I; 0; X], X = -(A00^-1 C)^T, and B banded (its top-left block is
+    2 A00 and its bottom-right gains C^T A00^-1 C, both still positive definite). Then
+    A^-1 r = B^-1 r - Z S^-1 W^T B^-1 r with Z = B^-1 W and S = -A00^-1 + W^T Z.
+    """
+    wmat, zmat, a00, g, s, small = wood.wmat, wood.zmat, wood.a00, wood.g, wood.s, wood.small
+    nt = band.shape[1]
+    m = a00.shape[0]
+    if cyclic:
+        for a in range(m):
+            for b in range(m):
+                r, c = (a, b) if a >= b else (b, a)
+                a00[a, b] = band[r - c, c]
+                g[a, b] = corner[b, a]
+        dense_solve(a00, g, small)              # G = A00^-1 C
+        for a in range(m):
+            for b in range(a + 1):
+                band[a - b, b] += a00[a, b]
+                val = 0.0
+                for q in range(m):
+                    val += corner[a, q] * g[q, b]
+                band[a - b, nt - m + b] += val
+    if not band_cholesky(band, p):
+        return False
+    if cyclic:
+        wmat[:] = 0.0
+        for a in range(m):
+            wmat[a, a] = 1.0
+            for b in range(m):
+                wmat[nt - m + a, b] = -g[b, a]
+        zmat[:] = wmat
+        band_solve_columns(band, p, zmat)
+        for b in range(m):
+            for a in range(m):
+                s[a, b] = 0.0
+            s[b, b] = -1.0
+        dense_solve(a00, s, small)              # S = -A00^-1 ...
+        for a in range(m):
+            for b in range(m):
+                val = 0.0
+                for r in range(nt):
+                    val += wmat[r, a] * zmat[r, b]
+                s[a, b] += val                   # ... + W^T Z
+    return True
+
+
+@njit(cache=True, error_model="numpy")
+def solve(band, corner, cyclic, p, rhs, wood):
+    """Solve the factored Newton system in place into ``rhs`` (flat, node-major)."""
+    wmat, zmat, s, small, tmp = wood.wmat, wood.zmat, wood.s, wood.small, wood.tmp
+    nt = band.shape[1]
+    band_solve(band, p, rhs)
+    if cyclic:
+        m = s.shape[0]
+        for a in range(m):
+            val = 0.0
+            for r in range(nt):
+                val += wmat[r, a] * rhs[r]
+            corner[a, 0] = val                   # corner is free once factored: W^T y, then S^-1 W^T y
+            for b in range(1, m):
+                corner[a, b] = 0.0
+        dense_solve(s, corner, small)
+        for a in range(m):
+            tmp[a] = corner[a, 0]
+        for r in range(nt):
+            val = 0.0
+            for a in range(m):
+                val += zmat[r, a] * tmp[a]
+            rhs[r] -= val

@@ -1,0 +1,241 @@
+"""The integrator contract: what a method and its family provide, and the bundles their compiled loops take.
+
+A *method* is one name in :data:`ropesim.integrate.methods.METHODS` (``symplectic_euler``, ``rk4``, ...): a
+:class:`Method` record, the same name in TOML (``integrator.method``), on the command line and in code. A
+*family* is the :class:`Integrator` subclass that runs a kind of method (splitting schemes, explicit
+Runge-Kutta, the stiff SDIRK), one module each. ``ropesim.run`` looks the name up, builds
+``method.family(model, grid, method)`` and calls :meth:`Integrator.advance` chunk after chunk; it never asks
+which family it holds.
+
+To add a method of an existing family, give its coefficients (a splitting scheme's drift and kick
+coefficients, a Runge-Kutta method's Butcher table), its order and a line of documentation, and list it in
+``METHODS``. To add a family, write one module with:
+
+1. A :class:`Method` subclass: ``name``, ``order``, ``doc``, ``kind`` (a word for people, e.g. "splitting";
+   nothing branches on it), ``evaluations`` (force evaluations per step), :meth:`Method.amplification` (one
+   step's 2x2 map of the damped oscillator x'' = -omega^2 x - gamma x', from which :func:`stable_step` finds
+   the stability bound) and ``family`` (the class below). Flags say what the stability bound must know:
+   ``drag_explicit`` (the method integrates linear drag explicitly, so it limits the step),
+   ``exact_contact_kicks`` (the thrower's and guides' damping is integrated exactly) and
+   ``unconditionally_stable``.
+2. An :class:`Integrator` subclass whose ``__init__(model, grid, method)`` calls ``super().__init__`` (which
+   sets x, v, the ledger, the health limits, the held nodes and the step counter) and builds the family's
+   own state and scratch arrays from the :class:`~ropesim.model.build.Model`, and which provides:
+
+   - :meth:`Integrator._run` ``(n, frames)``: call the family's compiled loop for ``n`` steps from
+     ``self.step``, returning ``(steps done, frames written, status, node)``;
+   - :attr:`Integrator.force_evaluations`: force evaluations so far (Newton iterations for an implicit
+     method);
+   - ``STATE``: the names of its attributes (arrays, updated in place) that, with x, v, the ledger and the
+     step, make up its *complete* state: restoring them continues a run bit for bit (resume needs this).
+
+3. Its compiled loop, which must, for global steps step0 + 1 ... step0 + n (time = step * h):
+
+   - advance x and v (D, N) in place by uniform steps h, every force evaluated through the term list
+     (:func:`ropesim.model.terms.accelerations`) unless the family has a proved specialisation;
+   - keep every held node exactly on x0 + V t at every stage time t, with velocity V;
+   - treat linear drag (per-node b, ``Model.drag``) so that the method keeps its declared order;
+   - book the energy ledger (:mod:`ropesim.integrate.health`): drag loss, held-node work, the applied
+     terms' work (:func:`ropesim.model.terms.applied_accelerations`), each with a quadrature of the
+     method's own order, so that E(t) - E(0) - flows is the integration error alone;
+   - check the state's health every ``check_every`` global steps and at every saved frame, and stop at the
+     first problem, returning its status and node (:func:`ropesim.integrate.health.verdict`);
+   - save a frame after every global step s with s % save_every == 0 or s == total_steps;
+   - give the same numbers however the run is cut into calls (the schedule is global, the state complete).
+
+Bundles: compiled loops take a handful of namedtuples (Numba compiles them as structs) instead of long
+argument lists: :class:`Schedule` (scalars), :class:`Frames` and :class:`Held` (arrays), the model's
+:class:`~ropesim.model.terms.ModelParams`, and the family's own state and scratch bundles. A bundle is handed
+over once per call; inside the loop, per-node helpers take scalars, since every array handed to a compiled
+helper that is not inlined costs an atomic reference-count update.
+
+What a new *force term* must provide (its file in ``model/forces/``, its line in ``model/terms.py``) is
+listed in :class:`ropesim.model.forces.Term`; the families reach every term through the term list and the
+hooks, never by name.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import namedtuple
+from functools import lru_cache
+
+import numpy as np
+
+from .health import LEDGER_COLUMNS, initial_ledger, limits
+
+CHECK_EVERY = 64   # steps between blow-up checks: a blow-up is caught within this many steps
+
+Schedule = namedtuple("Schedule", ["step0", "n_steps", "total_steps", "h", "save_every", "check_every"])
+"""Which steps a call runs: from global step ``step0``, ``n_steps`` steps of ``h`` [s] out of ``total_steps``;
+a frame every ``save_every`` steps and at the last, a health check every ``check_every``."""
+
+Frames = namedtuple("Frames", ["t", "x", "v", "ledger"])
+"""Frame buffers of one call: t (F,) [s], x and v (F, D, N) [m, m/s], the ledger's flows (F, 3) [J]."""
+
+Held = namedtuple("Held", ["idx", "x0", "v"])
+"""The held (pinned or driven) nodes: indices (H,), positions at t = 0 (D, H) [m], velocities (D, H) [m/s]."""
+
+Advance = namedtuple("Advance", ["done", "written", "status", "node"])
+"""What a call did: steps done, frames written, health status (:mod:`ropesim.integrate.health`), its node."""
+
+
+class Method:
+    """One integration method: its name, order and documentation, its stability, and the family that runs it."""
+
+    name: str
+    order: int
+    doc: str
+    kind: str
+    drag_explicit = False          # linear drag evaluated explicitly (it then limits the stable step)
+    exact_contact_kicks = False    # the thrower's and guides' damping integrated exactly when their edges are smooth
+    unconditionally_stable = False
+
+    @property
+    def family(self) -> type:
+        """The :class:`Integrator` subclass that runs this method."""
+        raise NotImplementedError
+
+    @property
+    def evaluations(self) -> int:
+        """Force evaluations per step."""
+        raise NotImplementedError
+
+    @property
+    def backward_kicks(self) -> bool:
+        """True when a step contains a kick backwards in time (it amplifies by drag; see stable_step)."""
+        return False
+
+    def amplification(self, h: float, omega: float, gamma_force: float = 0.0, gamma_drag: float = 0.0):
+        """One step's 2x2 map of (x, v) for x'' = -omega^2 x - gamma_force x' - gamma_drag x'."""
+        raise NotImplementedError
+
+    @property
+    def stability_limit(self) -> float:
+        """Largest h omega for which the method stays bounded on a harmonic oscillator x'' = -omega^2 x."""
+        return stable_step(self, 1.0)
+
+
+def _stable(method: Method, h: float, omega: float, gamma_force: float, gamma_drag: float) -> bool:
+    try:
+        m = method.amplification(h, omega, gamma_force, gamma_drag)
+    except OverflowError:   # a backward kick's e^(gamma |c| h) beyond the float range: the kernel's factor is inf
+        return False
+    if not np.all(np.isfinite(m)):
+        return False
+    return bool(np.max(np.abs(np.linalg.eigvals(m))) <= 1.0 + 1e-9)
+
+
+@lru_cache(maxsize=4096)
+def stable_step(method: Method, omega: float, gamma_force: float = 0.0, gamma_drag: float = 0.0) -> float:
+    """Largest step h [s] for which ``method`` stays bounded on x'' = -omega^2 x - (gamma_force + gamma_drag) x'.
+
+    ``gamma_force`` [1/s] is damping the method evaluates explicitly (the thrower's and guides'), ``gamma_drag``
+    [1/s] the scene's linear drag (exact inside the splitting schemes' kicks, explicit in Runge-Kutta).
+    Infinite for an unconditionally stable method or when nothing oscillates or damps.
+    """
+    if method.unconditionally_stable:
+        return math.inf
+    rate = max(omega, gamma_force + (gamma_drag if method.drag_explicit else 0.0))
+    if rate <= 0.0:
+        return math.inf
+    h, factor = 1e-3 / max(rate, gamma_drag if method.backward_kicks else 0.0), 1.01
+    while h * rate < 20.0 and _stable(method, h * factor, omega, gamma_force, gamma_drag):
+        h *= factor
+    lo, hi = h, h * factor
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if _stable(method, mid, omega, gamma_force, gamma_drag) else (lo, mid)
+    return lo
+
+
+class Integrator:
+    """A family's integrator for one model, method and time grid: its complete state and its compiled loop.
+
+    ``advance(n)`` moves it n steps forward (see the module doc for what a family provides). Besides x and v
+    it carries the energy ledger (``ledger``: drag loss, work of held nodes, work of the box and guides,
+    initial energy, energy scale; see :mod:`ropesim.integrate.health`) and the step counter.
+    """
+
+    STATE: tuple[str, ...] = ()
+
+    def __init__(self, model, grid, method: Method):
+        self.model, self.grid, self.method = model, grid, method
+        self.x = model.x0.copy()
+        self.v = model.v0.copy()
+        self.step = 0
+        self.ledger = initial_ledger(model, self.x, self.v)
+        self.limits = limits(model)
+        self.held = Held(model.held_idx, model.held_x0, model.held_v)
+
+    # -- what a family provides --------------------------------------------------------------------------
+
+    def _run(self, n: int, frames: Frames) -> tuple:
+        """Run the compiled loop for ``n`` steps from ``self.step``; (steps done, frames written, status, node)."""
+        raise NotImplementedError
+
+    @property
+    def force_evaluations(self) -> int:
+        """Force evaluations so far."""
+        raise NotImplementedError
+
+    # -- shared ----------------------------------------------------------------------------------------------
+
+    @property
+    def t(self) -> float:
+        return self.step * self.grid.dt
+
+    def schedule(self, n: int) -> Schedule:
+        g = self.grid
+        return Schedule(self.step, n, g.steps, g.dt, g.save_every, CHECK_EVERY)
+
+    def frames_in(self, n: int) -> int:
+        """Frames saved by the next ``n`` steps."""
+        e, end = self.grid.save_every, self.step + n
+        count = end // e - self.step // e
+        if end == self.grid.steps and end % e:
+            count += 1
+        return count
+
+    def new_frames(self, n: int) -> Frames:
+        """Empty frame buffers for the next ``n`` steps."""
+        k = self.frames_in(n)
+        dim, nodes = self.x.shape
+        return Frames(np.zeros(k), np.zeros((k, dim, nodes)), np.zeros((k, dim, nodes)),
+                      np.zeros((k, len(LEDGER_COLUMNS))))
+
+    def advance(self, n: int, frames: Frames | None = None) -> Advance:
+        """Run ``n`` steps (fewer if the state goes bad), saving the frames due into ``frames``."""
+        if frames is None:
+            frames = self.new_frames(n)
+        result = Advance(*self._run(n, Frames(*frames)))
+        self.step += result.done
+        return result
+
+    def warm_up(self) -> float:
+        """Compile the loop (or load it from Numba's cache) with a zero-step call; returns the seconds it took."""
+        start = time.perf_counter()
+        self.advance(0)
+        return time.perf_counter() - start
+
+    def state(self) -> dict[str, np.ndarray]:
+        """The complete state, as named arrays (copies): restoring it continues the run bit for bit."""
+        out = {"step": np.array(self.step, dtype=np.int64)}
+        for name in ("x", "v", "ledger", *self.STATE):
+            out[name] = np.array(getattr(self, name), copy=True)
+        return out
+
+    def restore(self, state: dict[str, np.ndarray]) -> None:
+        """Continue from ``state`` (from :meth:`state`, of the same model, method and grid).
+
+        Arrays are copied into place, so the bundles the compiled loop holds keep pointing at them.
+        """
+        for name in ("x", "v", "ledger", *self.STATE):
+            mine = getattr(self, name)
+            theirs = np.asarray(state[name])
+            if theirs.shape != mine.shape or theirs.dtype != mine.dtype:
+                raise ValueError(f"saved state {name!r} has shape {theirs.shape} ({theirs.dtype}); this run needs "
+                                 f"{mine.shape} ({mine.dtype})")
+            np.copyto(mine, theirs)
+        self.step = int(state["step"])
