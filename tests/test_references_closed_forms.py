@@ -27,6 +27,7 @@ from references.towed_cable import (
     approach_exponent,
     continuous_cable,
     critical_angle,
+    crosswind_plane,
     critical_angle_general,
     critical_angle_linear,
     drag_parameter,
@@ -34,6 +35,7 @@ from references.towed_cable import (
     steady_state_full,
     steady_state_march,
     steady_state_positions,
+    to_3d,
     weight_in_fluid,
     with_,
 )
@@ -201,6 +203,32 @@ def test_long_line_converges_to_the_critical_angle_and_tangential_drag_slows_the
     assert tops[0.1] > 3 * tops[0.0]
 
 
+def test_crosswind_steady_state_is_the_2d_one_turned_about_the_vertical():
+    """Helicopter sling: forward 20 m/s, side wind 5 m/s. Build the 2-D solution for |u|, turn it into 3-D and
+    evaluate the 3-D loads (the conventions work in any dimension): every node balances, out of plane too."""
+    U, az = crosswind_plane(20.0, 5.0)
+    assert U == pytest.approx(math.hypot(20, 5)) and az == pytest.approx(math.atan2(5, 20))
+    line = TowedLine.uniform(20.0, 20, mu=0.13, d=0.016, EA=5e6, rho=1.225, g=G, cd_n=1.2, cd_t=0.02, u=(U, 0.0),
+                             end_mass=25.0, end_cd_area=0.05)
+    m = steady_state_march(line)
+    x3 = to_3d(m.x, az)
+    u3 = np.array([20.0, 5.0, 0.0])  # the line's velocity through the air
+    f = morison_node_forces(x3, np.broadcast_to(u3, x3.shape), line.seg_lengths, line.d, line.rho, line.cd_n,
+                            line.cd_t)
+    f[:, 2] += gravity_buoyancy_node_forces(line.seg_lengths, line.mu, line.d, line.rho, G, dim=3)[:, 2]
+    f[-1] += -0.5 * line.rho * 0.05 * np.linalg.norm(u3) * u3 + np.array([0, 0, -25.0 * G])
+    seg = np.diff(x3, axis=0)
+    e = seg / np.linalg.norm(seg, axis=1, keepdims=True)
+    f[:-1] += m.T[:, None] * e
+    f[1:] -= m.T[:, None] * e
+    # balances to round-off of the tensions (~270 N at the top)
+    assert np.abs(f[1:]).max() < 1e-10 * m.T.max()
+    # the line trails straight downwind of the relative wind: every node at -(cos az, sin az) * s horizontally
+    horiz = x3[:, :2]
+    cross = horiz[:, 0] * math.sin(az) - horiz[:, 1] * math.cos(az)
+    assert np.abs(cross).max() < 1e-12
+
+
 def test_continuous_cable_approaches_the_critical_angle_at_the_predicted_algebraic_rate():
     w = weight_in_fluid(2.0, 0.02, RHO_W, G)
     pc = float(critical_angle(1.5, w, RHO_W, 1.2, 0.02))
@@ -255,6 +283,16 @@ def test_terminal_velocity_with_both_drag_laws():
     assert cf.rope_terminal_velocity(mu, d, RHO_W, G, 0.0, b_n=2.0) == pytest.approx(w / 2.0, rel=1e-15)
     f = linear_drag_node_forces(np.array([[0.0, 0.0], [1.0, 0.0]]), np.array([0.0, -w / 2.0]), [1.0], 2.0, 0.0)
     np.testing.assert_allclose(f[:, 1], 0.5 * w, rtol=1e-15)  # each node L = 0.5: drag = its share of the weight
+
+
+def test_string_takeoff_estimates_are_terminal_speeds_and_ignore_loop_length():
+    v = cf.string_loop_takeoff_speeds(1.6e-3, 1.5e-3, cd_n=1.2, cd_t=0.02)
+    w = (1.6e-3 - 1.225 * math.pi * 1.5e-3 ** 2 / 4) * 9.80665
+    assert 0.5 * 1.225 * 0.02 * math.pi * 1.5e-3 * v["tangential"] ** 2 == pytest.approx(w, rel=1e-14)
+    assert 0.5 * 1.225 * 1.2 * 1.5e-3 * v["normal"] ** 2 == pytest.approx(w, rel=1e-14)
+    # the numbers quoted in STRING_SHOOTER_LITERATURE.md (cotton string, 1.5 mm, 1.6 g/m)
+    assert v["normal"] == pytest.approx(3.77, abs=0.01)
+    assert v["tangential"] == pytest.approx(16.5, abs=0.05)
 
 
 def test_drop_histories_solve_their_equations_of_motion():

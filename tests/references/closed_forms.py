@@ -68,6 +68,23 @@ def rope_terminal_velocity(mu, d, rho, g, cd_n=1.2, cd_t=0.0, b_n=0.0, b_t=0.0, 
     return sign * 2.0 * w / (b + math.sqrt(b * b + 4.0 * a * w))  # the stable root, no cancellation
 
 
+def string_loop_takeoff_speeds(mu, d, rho=1.225, g=9.80665, cd_n=1.2, cd_t=0.02):
+    """Two drag-weight balance speeds [m/s] for a string of mass per metre mu [kg/m], diameter d [m] in air, as
+    candidate estimates of the string shooter's takeoff speed (see STRING_SHOOTER_LITERATURE.md; these are
+    derived here, not taken from the papers):
+
+    - "tangential": skin drag per metre equals weight per metre, 1/2 rho Cd_t pi d U^2 = w: the string's end-on
+      terminal speed. In a steady loop every element moves along its own tangent, so in still air only this drag
+      acts; above this speed even a vertically falling branch gains tension along its motion.
+    - "normal": 1/2 rho Cd_n d U^2 = w, the broadside terminal speed (the scale of the transient, sideways motions).
+
+    Neither depends on the loop's length or launch angle (Abello et al. 2024 report that the takeoff speed does
+    not). Returns dict(tangential=..., normal=...).
+    """
+    return dict(tangential=rope_terminal_velocity(mu, d, rho, g, cd_n, cd_t, orientation="end-on"),
+                normal=rope_terminal_velocity(mu, d, rho, g, cd_n, cd_t, orientation="broadside"))
+
+
 def drop_quadratic(t, weight, mass, rho, cd, area):
     """Speed v(t) [m/s] and distance x(t) [m] fallen by a body released from rest under quadratic drag.
 

@@ -56,9 +56,19 @@ Without tangential drag c / a = 1 + 2 tan^2 phi_c. The same holds for the discre
 phi_c is an exact discrete steady state when there is no end body (every node's loads are proportional to its
 L_i), whatever the tangential drag, and with an end body the discrete line approaches phi_c going up.
 
+Crosswind: 3-D reduces to 2-D
+-----------------------------
+A sling under a helicopter flying at U with a side wind W sees a horizontal relative velocity u = (U, -W) (or
+any horizontal vector). Gravity is vertical and every drag term lies in the plane spanned by u and the node
+tangent, so a line lying in the vertical plane through u feels no force out of that plane: the 3-D steady state
+is the 2-D one for |u| = sqrt(U^2 + W^2), turned by atan2(W, U) about the vertical (``crosswind_plane``). The
+line trails straight downwind of the relative wind, not behind the helicopter's track.
+
 Sources: Pode, L. (1951), "Tables for computing the equilibrium configuration of a flexible cable in a uniform
-stream", DTMB Report 687; Blevins, R. D., "Applied Fluid Dynamics Handbook" (1984), ch. 10 (towed cables,
-critical angle); the discrete loads follow MoorDyn (Hall & Goupee 2015, Ocean Engineering 104).
+stream", DTMB Report 687 (the critical-angle tow); Casarella, M. J. & Parsons, M. (1970), "Cable systems under
+hydrodynamic loading", Marine Technology Society Journal 4(4) (review of the loading functions); Chakrabarti, B. &
+Hanna, J. A. (2016), "Catenaries in viscous fluid", J. Fluids Struct. 66, arXiv:1509.01282 (closed forms under
+LINEAR drag, including towing); the discrete loads follow MoorDyn (Hall & Goupee 2015, Ocean Engineering 104, 590-603).
 """
 
 from __future__ import annotations
@@ -124,6 +134,20 @@ def critical_angle_general(U, w, rho, cd_n, d, b_n=0.0):
         return 0.0
     f = lambda p: w * math.sin(p) - kn * U * U * math.cos(p) ** 2 - b_n * U * math.cos(p)  # noqa: E731
     return brentq(f, 0.0, 0.5 * math.pi, xtol=1e-15, rtol=4 * np.finfo(float).eps)
+
+
+def crosswind_plane(forward, side):
+    """(|u|, azimuth): the 2-D problem's relative speed and the angle [rad] by which its plane is turned about the
+    vertical, for a tow point moving at ``forward`` [m/s] along +x with a wind of ``side`` [m/s] blowing towards
+    -y (relative velocity of the line through the air (forward, side)). See the module docstring."""
+    return math.hypot(forward, side), math.atan2(side, forward)
+
+
+def to_3d(x2, azimuth):
+    """Place a 2-D solution (x along the relative velocity, z up) in 3-D, turned by ``azimuth`` about z."""
+    x2 = np.asarray(x2, dtype=float)
+    c, s = math.cos(azimuth), math.sin(azimuth)
+    return np.stack([x2[:, 0] * c, x2[:, 0] * s, x2[:, 1]], axis=1)
 
 
 def approach_exponent(U, w, rho, cd_n, cd_t, d):
@@ -509,7 +533,7 @@ def with_(line: TowedLine, **changes) -> TowedLine:
 
 __all__ = [
     "weight_in_fluid", "drag_parameter", "critical_angle", "critical_angle_linear", "critical_angle_general",
-    "approach_exponent", "TowedLine", "TowedSolution", "steady_state_march", "steady_state_full",
+    "approach_exponent", "crosswind_plane", "to_3d", "TowedLine", "TowedSolution", "steady_state_march", "steady_state_full",
     "steady_state_positions", "residual",
     "continuous_cable", "with_", "node_lengths",
 ]
