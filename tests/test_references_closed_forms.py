@@ -115,12 +115,12 @@ CASES = {
     "normal drag only": dict(),
     "tangential drag": dict(cd_t=0.05),
     "end mass": dict(end_mass=20.0, cd_t=0.01),
-    "end drogue (drag body)": dict(end_cd_area=0.5, cd_t=0.01),
+    "end drogue (drag body)": dict(end_area=0.5, cd_t=0.01),
     "linear drag too": dict(b_n=3.0, b_t=1.0, cd_t=0.02, end_mass=5.0),
     "stretched drag length, soft": dict(EA=2e4, cd_t=0.02, end_mass=10.0, drag_length="stretched"),
     "current with an upward part": dict(u=(1.2, -0.3), cd_t=0.02, end_mass=10.0),
     "light line in air, crosswind": dict(mu=0.3, d=0.012, rho=1.225, cd_n=1.2, cd_t=0.01, EA=5e5, u=(8.0, 0.0),
-                                         end_mass=2.0, end_cd_area=0.3),
+                                         end_mass=2.0, end_area=0.3, end_cd=1.0),
 }
 
 
@@ -177,6 +177,16 @@ def test_inextensible_line():
     assert np.abs(stiff.x - m.x).max() > 0  # and it does stretch
 
 
+def test_end_body_drag_uses_cd_times_area():
+    a = steady_state_march(TowedLine.uniform(30.0, 10, **{**BASE, "end_area": 0.25, "end_cd": 2.0}))
+    b = steady_state_march(TowedLine.uniform(30.0, 10, **{**BASE, "end_area": 0.5, "end_cd": 1.0}))
+    np.testing.assert_allclose(a.x, b.x, atol=1e-12)
+    # a drogue pulls the bottom flatter than phi_c, a weight steeper
+    pc = float(critical_angle(1.5, weight_in_fluid(2.0, 0.02, RHO_W, G), RHO_W, 1.2, 0.02))
+    assert a.angles[-1] > pc
+    assert steady_state_march(TowedLine.uniform(30.0, 10, **{**BASE, "end_mass": 5.0})).angles[-1] < pc
+
+
 def test_the_free_end_settles_in_the_stable_direction():
     """A single heavy node on one segment in a current: its segment lies along its total load."""
     line = TowedLine.uniform(1.0, 1, mu=1.0, d=0.01, rho=1000.0, g=9.81, cd_n=1.0, cd_t=0.0, u=(2.0, 0.0))
@@ -209,7 +219,7 @@ def test_crosswind_steady_state_is_the_2d_one_turned_about_the_vertical():
     U, az = crosswind_plane(20.0, 5.0)
     assert U == pytest.approx(math.hypot(20, 5)) and az == pytest.approx(math.atan2(5, 20))
     line = TowedLine.uniform(20.0, 20, mu=0.13, d=0.016, EA=5e6, rho=1.225, g=G, cd_n=1.2, cd_t=0.02, u=(U, 0.0),
-                             end_mass=25.0, end_cd_area=0.05)
+                             end_mass=25.0, end_cd=1.0, end_area=0.05)
     m = steady_state_march(line)
     x3 = to_3d(m.x, az)
     u3 = np.array([20.0, 5.0, 0.0])  # the line's velocity through the air

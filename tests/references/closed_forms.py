@@ -203,7 +203,7 @@ class CatenaryResult:
 
 def catenary_suspended_xz(H, V, L, w, EA):
     """Fairlead offsets (X, Z) from the anchor of a fully suspended elastic catenary with fairlead tension
-    components H, V (Irvine 1981, eqs 2.29-2.30; Jonkman 2007 eq. 2-2):
+    components H, V (Irvine 1981, ch. 2; Jonkman 2007, sec. 4.2):
 
     X = (H/w) [asinh(V/H) - asinh((V - wL)/H)] + H L / EA
     Z = (H/w) [sqrt(1 + (V/H)^2) - sqrt(1 + ((V - wL)/H)^2)] + (V L - w L^2 / 2) / EA
@@ -215,7 +215,8 @@ def catenary_suspended_xz(H, V, L, w, EA):
 
 
 def catenary_touchdown_xz(H, V, L, w, EA, CB=0.0):
-    """(X, Z) of an elastic catenary whose anchor end lies on a flat seabed (Jonkman 2007, eq. 2-3; MAP++ manual):
+    """(X, Z) of an elastic catenary whose anchor end lies on a flat seabed (Jonkman 2007, sec. 4.2; the MAP++
+    theory manual):
 
     LB = L - V/w (length on the seabed),
     X = LB + (H/w) asinh(V/H) + H L / EA + (CB w / (2 EA)) [-LB^2 + (LB - H/(CB w)) max(LB - H/(CB w), 0)]
@@ -318,7 +319,7 @@ def _vertical_hang_V(Z, w, EA):
 
 
 def inextensible_touchdown(H, Z, L, w):
-    """The textbook inextensible catenary with touchdown (Faltinsen 1990, eqs 8.x; Irvine 1981): given the
+    """The textbook inextensible catenary with touchdown (Faltinsen 1990, ch. 8; Irvine 1981, ch. 1): given the
     horizontal tension H and the fairlead height Z, with a = H / w:
 
     suspended length l_s = sqrt(Z^2 + 2 Z a), V = w l_s, X = L - l_s + a asinh(l_s / a), T_fairlead = H + w Z.

@@ -1,5 +1,6 @@
 r"""The towed cable: its critical angle (closed form), the continuous cable (an ODE), and the exact steady state
-of the discrete lumped-mass line (two independent scipy solves). No ropesim code is used.
+of the discrete lumped-mass line (three scipy solves: a node-by-node march, a simultaneous solve over segment
+tensions and angles, and one over raw node positions). No ropesim code is used.
 
 Conventions (see ``references.conventions``; 2-D, coordinates (x, z), z up, SI units):
 
@@ -178,7 +179,8 @@ class TowedLine:
     cd_n, cd_t: normal / tangential quadratic drag coefficients [-] (on d L_i and pi d L_i)
     b_n, b_t: linear drag per metre [N s/m^2]
     u: velocity of the line relative to the fluid, (ux, uz) [m/s] (tow velocity minus current)
-    end_mass [kg], end_volume [m^3] (buoyancy), end_cd_area = Cd_b * A_b [m^2]: a body at node N
+    end_mass [kg], end_volume [m^3] (buoyancy), end_area A_b [m^2] and end_cd Cd_b [-]: a body at node N with
+    isotropic drag -1/2 rho Cd_b A_b |u| u
     drag_length: "unstretched" or "stretched": which L_i the drag uses
     """
 
@@ -195,7 +197,8 @@ class TowedLine:
     u: tuple = (1.0, 0.0)
     end_mass: float = 0.0
     end_volume: float = 0.0
-    end_cd_area: float = 0.0
+    end_area: float = 0.0
+    end_cd: float = 1.0
     drag_length: str = "unstretched"
 
     @classmethod
@@ -214,7 +217,7 @@ class TowedLine:
     def end_body_force(self) -> np.ndarray:
         """Weight, buoyancy and isotropic drag of the end body [N]."""
         u = np.asarray(self.u, dtype=float)
-        f = -0.5 * self.rho * self.end_cd_area * np.linalg.norm(u) * u
+        f = -0.5 * self.rho * self.end_cd * self.end_area * np.linalg.norm(u) * u
         f[1] += (self.rho * self.end_volume - self.end_mass) * self.g
         return f
 
