@@ -204,12 +204,18 @@ class _Ctx:
 
 
 def _check_scene(scene: S.Scene, source: str) -> S.Scene:
-    """Checks that involve more than one key."""
-    rope, n = scene.rope, scene.rope.nodes
-
+    """Checks that involve more than one key; returns the scene with the defaults that depend on others filled."""
     def fail(key, message):
         raise SceneError(source, key, message)
 
+    _check_name_and_length(scene, fail)
+    _check_topology(scene, fail)
+    _check_nodes(scene, fail)
+    scene = _resolve_initial(scene, fail)
+    return _resolve_omegas(scene, fail)
+
+
+def _check_name_and_length(scene: S.Scene, fail) -> None:
     name = scene.name
     if not name or name in (".", "..") or "/" in name or "\\" in name or not name.isprintable():
         fail("name", f"must be a plain folder name (runs go to runs/<name>/): printable, without / or \\, "
@@ -219,6 +225,9 @@ def _check_scene(scene: S.Scene, source: str) -> S.Scene:
         fail("integrator.t_end", f"t_end / dt = {steps:.3g} steps; at most {MAX_STEPS:.0e} are allowed "
                                  f"(t_end = {scene.integrator.t_end:g} s, dt = {scene.integrator.dt:g} s)")
 
+
+def _check_topology(scene: S.Scene, fail) -> None:
+    rope, n = scene.rope, scene.rope.nodes
     if rope.closed and n < 3:
         fail("rope.nodes", f"a closed loop needs at least 3 nodes, got {n}")
     if scene.bending is not None:
@@ -228,11 +237,20 @@ def _check_scene(scene: S.Scene, source: str) -> S.Scene:
         if not rope.closed and n < 3:
             fail("bending", f"bending springs need at least 3 nodes on a line, got {n}")
 
+
+def _node_index(n: int, fail):
+    """A checker of node indices for a rope of ``n`` nodes: the non-negative index, or a refusal naming the key."""
     def index(key, i):
         if not -n <= i < n:
             fail(key, f"node index {i} is past the rope's end: allowed -{n} to {n - 1}")
         return i % n
+    return index
 
+
+def _check_nodes(scene: S.Scene, fail) -> None:
+    """Held (pinned, driven) and overridden nodes: on the rope, each held once, at least one free."""
+    n = scene.rope.nodes
+    index = _node_index(n, fail)
     held: dict[int, str] = {}
     if scene.pinned is not None:
         for j, i in enumerate(scene.pinned.nodes):
@@ -261,7 +279,10 @@ def _check_scene(scene: S.Scene, source: str) -> S.Scene:
         if o.mass is None and o.drag is None:
             fail(f"overrides.{j}", "sets neither mass nor drag; give at least one")
 
-    init = scene.initial
+
+def _resolve_initial(scene: S.Scene, fail) -> S.Scene:
+    """The initial shape fits the rope; the square loop's default centre is the thrower's."""
+    rope, n, init = scene.rope, scene.rope.nodes, scene.initial
     if isinstance(init, (S.HangingStart, S.LineStart)) and rope.closed:
         fail("initial.shape", f"'{init.shape}' makes an open line; a closed loop starts as 'square_loop' or "
                               f"'points'")
@@ -275,15 +296,18 @@ def _check_scene(scene: S.Scene, source: str) -> S.Scene:
     if isinstance(init, S.PointsStart):
         if len(init.points) != n:
             fail("initial.points", f"has {len(init.points)} points but rope.nodes is {n}; give one per node")
-    if isinstance(init, S.LineStart) and init.start == init.end:
-        fail("initial.end", "equals initial.start; a line needs two distinct ends")
-    if isinstance(init, (S.PointsStart,)):
         pts = init.points
         pairs = [(i, i + 1) for i in range(n - 1)] + ([(n - 1, 0)] if rope.closed else [])
         for i, j in pairs:
             if pts[i] == pts[j]:
                 fail("initial.points", f"nodes {i} and {j} coincide; a spring between them has no direction")
+    if isinstance(init, S.LineStart) and init.start == init.end:
+        fail("initial.end", "equals initial.start; a line needs two distinct ends")
+    return scene
 
+
+def _resolve_omegas(scene: S.Scene, fail) -> S.Scene:
+    """The thrower's default omega0, and each guide's default (the thrower's)."""
     if scene.thrower is not None and scene.thrower.omega0 is None:
         w = scene.thrower.resolved_omega0
         if not MIN_POSITIVE <= w <= MAX_MAGNITUDE:
@@ -297,9 +321,7 @@ def _check_scene(scene: S.Scene, source: str) -> S.Scene:
                 fail(f"guides.{j}.omega0", "missing: needed when there is no [thrower] to take it from")
             guide = replace(guide, omega0=scene.thrower.omega0)
         guides.append(guide)
-    scene = replace(scene, guides=tuple(guides))
-
-    return scene
+    return replace(scene, guides=tuple(guides))
 
 
 # ------------------------------------------------------------------------------ single values
