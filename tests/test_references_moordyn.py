@@ -7,6 +7,7 @@ Units: SI (m, s, kg, N). Needs the ``moordyn`` package (the ``bench`` extra); Mo
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -413,3 +414,62 @@ def test_cfl_time_step():
         dt = cmoordyn.get_dt(system)
     seg = 1700.0 / 170
     assert dt == pytest.approx(0.1 * 2 * math.pi * math.sqrt(390.0 * seg / (1.674e9 / seg)), rel=1e-12)
+
+
+# ----------------------------------------------------------------------------- stored references
+
+
+def stored_cases():
+    """The stored reference cases: names of tests/data/moordyn/<case>.json."""
+    return sorted(p.stem for p in DATA.glob("*.json"))
+
+
+def test_stored_references_exist_and_are_small():
+    """The references the brief asks for are there, each with its inputs and wall times, and under 2 MB in all."""
+    names = stored_cases()
+    assert {"WD0050_Chain", "WD0200_Chain", "WD0600_Chain", "BeamCantilevered", "lowe_and_langley_2006"} <= set(names)
+    total = sum(p.stat().st_size for p in DATA.rglob("*") if p.is_file())
+    assert total < 2_000_000
+    for name in names:
+        meta = json.loads((DATA / f"{name}.json").read_text())
+        data = np.load(DATA / f"{name}.npz")
+        assert meta["moordyn_version"] and meta["dynamic"]["wall_time_s"] > 0
+        assert data["t"].shape == data["fairlead_tension"].shape == data["anchor_tension"].shape
+        assert data["node_positions"].shape == (len(data["t"]), len(data["node_index"]), 3)
+
+
+def test_stored_static_tensions_reproduce():
+    """The static fairlead tension stored for each chain case is what MoorDyn's IC gives now (deterministic: to
+    1e-9, the tolerance only absorbs the JSON's decimal round trip)."""
+    for name in ("WD0050_Chain", "WD0200_Chain", "WD0600_Chain"):
+        meta = json.loads((DATA / f"{name}.json").read_text())
+        run = run_input_file(CASES / meta["input_file"])
+        assert run.fairlead_tension[0] == pytest.approx(meta["static"]["fairlead_tension_N"], rel=1e-9)
+        assert run.anchor_tension[0] == pytest.approx(meta["static"]["anchor_tension_N"], rel=1e-9)
+
+
+@pytest.fixture(scope="module")
+def reference_script():
+    """scripts/moordyn_reference.py, imported as a module (it is not a package)."""
+    import importlib.util
+    import sys
+
+    path = Path(__file__).parent.parent / "scripts" / "moordyn_reference.py"
+    spec = importlib.util.spec_from_file_location("moordyn_reference", path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # its dataclasses look their module up there
+    spec.loader.exec_module(module)
+    yield module
+    del sys.modules[spec.name]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["WD0050_Chain", "WD0200_Chain", "WD0600_Chain", "lowe_and_langley_2006",
+                                  "BeamCantilevered"])
+def test_stored_dynamic_runs_reproduce(name, reference_script):
+    """Each stored dynamic run regenerates from scripts/moordyn_reference.py's recipe to 1e-9 (the same binary
+    gives bit-identical runs; the tolerance allows another CPU's libm)."""
+    data = np.load(DATA / f"{name}.npz")
+    fresh = reference_script.dynamic_run(reference_script.CASES[name])
+    np.testing.assert_allclose(fresh.fairlead_tension, data["fairlead_tension"], rtol=1e-9, atol=1e-6)
+    np.testing.assert_allclose(fresh.positions[:, data["node_index"]], data["node_positions"], rtol=1e-9, atol=1e-9)

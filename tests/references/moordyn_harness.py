@@ -78,7 +78,8 @@ class Environment:
 
     depth: water depth (m), seabed at z = -depth; g (m/s^2); rho_w: water density (kg/m^3); kbot: seabed
     stiffness (Pa/m = N/m^3, per metre of penetration per unit of d x contact length); cbot: seabed damping
-    (Pa s/m); friction: MoorDyn ``FrictionCoefficient`` (-); fric_damp: ``FricDamp`` (s/m, see the conventions);
+    (Pa s/m); friction: MoorDyn ``FrictionCoefficient`` (-); fric_damp: ``FricDamp`` (N s/m per node, whatever its
+    length or load: see MOORDYN_CONVENTIONS.md);
     stat_dyn_fric_scale: ``StatDynFricScale`` (-); current: uniform current velocity (m/s), given to MoorDyn as a
     steady current profile (``Currents 1``). MoorDyn ignores currents during its initial-condition solve.
     """
@@ -273,6 +274,7 @@ QUIET_OPTIONS = {"writeLog": 0, "disableOutput": 1, "disableOutTime": 1}
 
 
 def _vec(x) -> np.ndarray:
+    """Any 3 numbers as a float array of shape (3,), units unchanged."""
     return np.asarray(x, dtype=float).reshape(3)
 
 
