@@ -203,7 +203,8 @@ def line_input_text(
 ---------------------- LINE TYPES -----------------------------------
 TypeName Diam Mass/m EA BA/-zeta EI Cd Ca CdAx CaAx
 (name) (m) (kg/m) (N) (N-s/-) (N-m^2) (-) (-) (-) (-)
-rope {line.diameter!r} {line.mass_per_length!r} {line.EA!r} {line.BA!r} {line.EI!r} {line.Cd!r} {line.Ca!r} {line.CdAx!r} {line.CaAx!r}
+rope {line.diameter!r} {line.mass_per_length!r} {line.EA!r} {line.BA!r} {line.EI!r} \
+{line.Cd!r} {line.Ca!r} {line.CdAx!r} {line.CaAx!r}
 ---------------------- POINTS ---------------------------------------
 ID Attachment X Y Z Mass Volume CdA Ca
 (#) (word/ID) (m) (m) (m) (kg) (m^3) (m^2) (-)
@@ -436,7 +437,9 @@ def run_input_file(
 
 
 @contextlib.contextmanager
-def moordyn_system(input_text: str, coupled_position=None, ic: bool = True, extra_files: Mapping[str, str] | None = None):
+def moordyn_system(
+    input_text: str, coupled_position=None, ic: bool = True, extra_files: Mapping[str, str] | None = None
+):
     """MoorDyn created from ``input_text`` (written, with ``extra_files`` (name -> text) beside it, into a temporary
     folder) and initialised, for callers that query MoorDyn's API themselves.
 
