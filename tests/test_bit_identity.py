@@ -108,10 +108,15 @@ def test_reproduces_recorded_run_bit_for_bit(all_scenes, index, name, method):
     assert (got["status"], got["steps"], got["force_evaluations"]) == (
         want["status"], want["steps"], want["force_evaluations"])
     with np.load(DATA / f"{key}.npz") as rec:
-        for array in ("t", "x", "v", "ledger"):
-            assert got[array].shape == rec[array].shape, array
-            assert np.array_equal(got[array], rec[array]), f"{array} differs (largest difference " \
-                f"{np.max(np.abs(got[array] - rec[array]))})"
+        recorded = {a: rec[a] for a in ("t", "x", "v", "ledger")}
+    # the ledger has gained columns since (fluid, internal damping, seabed work): none of these scenes books any
+    booked = recorded["ledger"].shape[1]
+    assert not np.any(got["ledger"][:, booked:]), "a scene without fluid, damping or seabed booked their work"
+    got["ledger"] = got["ledger"][:, :booked]
+    for array, want_array in recorded.items():
+        assert got[array].shape == want_array.shape, array
+        assert np.array_equal(got[array], want_array), f"{array} differs (largest difference " \
+            f"{np.max(np.abs(got[array] - want_array))})"
 
 
 def record() -> None:

@@ -93,7 +93,7 @@ def run_once(scene: Scene, method: str, dt: float, repeats: int = 1, exact_conta
     (see :mod:`ropesim.integrate.contact`; by default it does when their edges are smoothed).
     """
     from ..integrate.grid import TimeGrid
-    from ..integrate.health import BOX, DRAG, HELD
+    from ..integrate.health import net_flow
     from ..integrate.methods import make_integrator
     from ..model.energy import energy_terms
 
@@ -116,7 +116,7 @@ def run_once(scene: Scene, method: str, dt: float, repeats: int = 1, exact_conta
     energy_error = math.nan
     if finite and status == OK:
         energy = float(energy_terms(model, stepper.x.T, stepper.v.T)["total"])
-        energy_error = energy - ledger[E0] - (ledger[HELD] + ledger[BOX] - ledger[DRAG])
+        energy_error = energy - ledger[E0] - net_flow(ledger)
     return RunResult(stepper.x.copy(), stepper.v.copy(), "completed" if status == OK else STATUS_NAMES[status],
                      energy_error, times, stepper.force_evaluations, stepper.step)
 

@@ -28,8 +28,12 @@ LEDGER = "ledger.npz"
 FRAME_BLOCK = 256
 
 
+GAINS = ("held_work", "box_work", "fluid_work", "internal_work", "seabed_work")   # work done on the rope [J]
+LOSSES = ("drag_loss",)                                                           # energy taken out [J]
+
+
 def write_ledger(folder: Path, t: np.ndarray, flows: np.ndarray, energy0: float) -> None:
-    """Write ``ledger.npz`` atomically: the cumulative flows (F, 3) at the saved frames' times."""
+    """Write ``ledger.npz`` atomically: the cumulative flows (F, C) at the saved frames' times."""
     from ..io.trajectory import write_npz_atomic
 
     arrays = {"t": np.asarray(t)[:len(flows)]}
@@ -39,24 +43,27 @@ def write_ledger(folder: Path, t: np.ndarray, flows: np.ndarray, energy0: float)
 
 
 def read_flows(folder: Path) -> tuple[np.ndarray, float] | None:
-    """(flows (F, 3), energy0) from a run folder's ``ledger.npz``, or None when it has none."""
+    """(flows (F, C), energy0) from a run folder's ``ledger.npz``, or None when it has none; a column an older
+    ropesim did not book is zero."""
     path = Path(folder) / LEDGER
     if not path.is_file():
         return None
     with np.load(path) as npz:
-        return np.stack([npz[name] for name in LEDGER_COLUMNS], axis=1), float(npz["energy0"])
+        frames = len(npz["t"])
+        return (np.stack([npz[name] if name in npz.files else np.zeros(frames) for name in LEDGER_COLUMNS], axis=1),
+                float(npz["energy0"]))
 
 
 def ledger_series(model: Model, x: np.ndarray, v: np.ndarray, flows: np.ndarray, energy0: float) -> dict:
     """Every term of the ledger per frame [J]: the energy terms, the flows and the residual.
 
-    ``x``, ``v`` are (F, N, D) frames (possibly memory-mapped; read in blocks), ``flows`` (F, 3).
+    ``x``, ``v`` are (F, N, D) frames (possibly memory-mapped; read in blocks), ``flows`` (F, C).
     """
     blocks = [energy_terms(model, x[s:s + FRAME_BLOCK], v[s:s + FRAME_BLOCK]) for s in range(0, len(flows), FRAME_BLOCK)]
     out = {key: np.concatenate([b[key] for b in blocks]) for key in blocks[0]} if blocks else {}
     for c, name in enumerate(LEDGER_COLUMNS):
         out[name] = flows[:, c]
-    flowed = out["held_work"] + out["box_work"] - out["drag_loss"]
+    flowed = sum(out[name] for name in GAINS) - sum(out[name] for name in LOSSES)
     out["residual"] = out["total"] - energy0 - flowed
     return out
 
@@ -64,15 +71,15 @@ def ledger_series(model: Model, x: np.ndarray, v: np.ndarray, flows: np.ndarray,
 def ledger_summary(series: dict, energy0: float) -> dict:
     """The balance at the end: each flow, the residual, and the residual relative to the energy that flowed.
 
-    "Energy that flowed" is the largest D + |W_held| + |W_box| reached or, when larger (as in a closed system,
+    "Energy that flowed" is the largest D + sum |W| reached or, when larger (as in a closed system,
     where nothing flows), the largest change of any single energy term (the energy that moved between terms),
     so the relative residual is always measured against energy that actually moved. ``residual_growth`` compares the
     largest |residual| in the last and the first half of the run: well above 1 on a run that is going wrong.
     """
     residual = np.abs(series["residual"])
-    flowed = series["drag_loss"] + np.abs(series["held_work"]) + np.abs(series["box_work"])
+    flowed = sum(series[name] for name in LOSSES) + sum(np.abs(series[name]) for name in GAINS)
     moved = float(flowed.max()) if len(flowed) else 0.0
-    terms = [k for k in ("kinetic", "spring", "bending", "gravity") if k in series]
+    terms = [k for k in series if k not in ("total", "residual", *GAINS, *LOSSES)]
     exchanged = max(float(np.ptp(series[k])) for k in terms) if len(residual) else 0.0
     basis = "flows"
     if exchanged > moved:
@@ -86,6 +93,9 @@ def ledger_summary(series: dict, energy0: float) -> dict:
         "drag_loss_J": float(series["drag_loss"][-1]),
         "held_work_J": float(series["held_work"][-1]),
         "box_work_J": float(series["box_work"][-1]),
+        "fluid_work_J": float(series["fluid_work"][-1]),
+        "internal_work_J": float(series["internal_work"][-1]),
+        "seabed_work_J": float(series["seabed_work"][-1]),
         "residual_J": float(series["residual"][-1]),
         "max_residual_J": float(residual.max()) if len(residual) else 0.0,
         "energy_flowed_J": moved,

@@ -176,7 +176,7 @@ def probe(scene, method: str, dt: float, steps: int = PROBE_STEPS) -> bool:
     import dataclasses
 
     from ..integrate.grid import TimeGrid
-    from ..integrate.health import BOX, DRAG, E0, HELD, OK, SCALE
+    from ..integrate.health import E0, OK, SCALE, net_flow
     from ..integrate.methods import make_integrator
     from ..model.build import build
     from ..model.energy import energy_terms
@@ -195,7 +195,7 @@ def probe(scene, method: str, dt: float, steps: int = PROBE_STEPS) -> bool:
         return False
     ledger = stepper.ledger
     energy = float(energy_terms(model, stepper.x.T, stepper.v.T)["total"])
-    residual = energy - ledger[E0] - (ledger[HELD] + ledger[BOX] - ledger[DRAG])
+    residual = energy - ledger[E0] - net_flow(ledger)
     return abs(residual) <= ledger[SCALE]
 
 

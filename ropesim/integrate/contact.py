@@ -37,7 +37,7 @@ def exact_contact_kicks(x, v, acc, out, nodes, tau, gamma, free, forces):
     """For every free node the box or a circle touches, its velocity after an exact kick of length ``tau``
     into ``out[:, i]``, its index into ``nodes``; returns how many. ``acc`` is a(x, v) without drag and
     ``gamma`` (N,) the drag rate b / m."""
-    inv_mass, flags, spring, bending, gravity, thrower, guides = forces
+    inv_mass, flags, thrower, guides = forces.inv_mass, forces.flags, forces.thrower, forces.guides
     dim, n = x.shape
     three_d = dim == 3
     box = box_of(thrower)

@@ -5,16 +5,19 @@ Blow-up check (every ``check_every`` steps and at every saved frame), in this or
 - a non-finite position or velocity (NON_FINITE, naming the first such node);
 - a spring stretched beyond ``limits[0]`` times its rest length (OVERSTRETCH, naming its first node);
 - runaway energy (RUNAWAY_ENERGY, naming the fastest node): the energy balance residual
-  E(t) - E(0) - (W_held + W_box - D_drag) exceeds ``limits[1]`` times the initial energy scale
-  ``ledger[SCALE]`` plus ``limits[2]`` times the energy that flowed, |W_held| + |W_box| + D_drag. A stable
+  E(t) - E(0) - (W_held + W_box + W_fluid + W_internal + W_seabed - D_drag) exceeds ``limits[1]`` times the
+  initial energy scale ``ledger[SCALE]`` plus ``limits[2]`` times the energy that flowed, the sum of the
+  flows' magnitudes (:func:`flows`). A stable
   run keeps that residual a small fraction of both (it is the integrator's energy error: at most 0.15 of the
   scale and 0.06 of the flows in the built-in scenes even at 0.95 of the stability bound); an unstable one
   grows it geometrically, or saturates into nonsense whose balance is off by a large fraction of the (itself
   inflated) flows.
 
-The ledger (float64 array of LEDGER_SIZE) holds the cumulative energy lost to drag D [J], the work done by
-held (pinned or driven) nodes on the rope W_held [J], the work done by the thrower box and guide circles
-W_box [J], and the initial mechanical energy E0 and the energy scale used above.
+The ledger (float64 array of LEDGER_SIZE) holds, cumulative [J]: the energy lost to the linear [drag] D (in
+still air; in a flow, its push + b U is fluid work), the work of held (pinned or driven) nodes' supports on
+the rope W_held, the work of the thrower box and guide circles W_box, the work of the fluid W_fluid (drag on
+the relative velocity, a flow's push, added mass), the work of the rope's axial damping W_internal (never
+positive) and of the seabed W_seabed; then the initial mechanical energy E0 and the energy scale used above.
 """
 
 import numpy as np
@@ -26,9 +29,10 @@ OK, NON_FINITE, OVERSTRETCH, RUNAWAY_ENERGY, NEWTON_FAILED = 0, 1, 2, 3, 4
 STATUS_NAMES = {OK: "ok", NON_FINITE: "non-finite", OVERSTRETCH: "overstretched", RUNAWAY_ENERGY: "runaway energy",
                 NEWTON_FAILED: "Newton solve failed"}
 
-DRAG, HELD, BOX, E0, SCALE = 0, 1, 2, 3, 4
-LEDGER_SIZE = 5
-LEDGER_COLUMNS = ("drag_loss", "held_work", "box_work")  # what each saved frame records, cumulative [J]
+DRAG, HELD, BOX, FLUID, INTERNAL, SEABED, E0, SCALE = 0, 1, 2, 3, 4, 5, 6, 7
+LEDGER_SIZE = 8
+LEDGER_COLUMNS = ("drag_loss", "held_work", "box_work", "fluid_work", "internal_work", "seabed_work")
+"""What each saved frame records of the ledger, cumulative [J] (the first LEDGER_COLUMNS entries)."""
 
 
 @njit(cache=True, error_model="numpy")
@@ -59,16 +63,25 @@ def check_health(x, v, mass, params, ledger, limits):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def balance_status(energy, stretch, held, box, drag, e0, scale, max_stretch, of_scale, of_flows):
-    """OVERSTRETCH, RUNAWAY_ENERGY or OK from the energy [J], worst stretch and ledger entries alone.
+def flows(ledger):
+    """(energy that flowed in, net [J]; the sum of the flows' magnitudes [J]) from the ledger."""
+    flowed = ledger[HELD] + ledger[BOX] - ledger[DRAG] + ledger[FLUID] + ledger[INTERNAL] + ledger[SEABED]
+    moved = (abs(ledger[HELD]) + abs(ledger[BOX]) + ledger[DRAG] + abs(ledger[FLUID]) + abs(ledger[INTERNAL])
+             + abs(ledger[SEABED]))
+    return flowed, moved
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def balance_status(energy, stretch, flowed, moved, e0, scale, max_stretch, of_scale, of_flows):
+    """OVERSTRETCH, RUNAWAY_ENERGY or OK from the energy [J], worst stretch and the ledger's flows alone
+    (:func:`flows`).
 
     Scalars only, so the compiled loops can call it at every check without handing over arrays (whose
     reference counting costs more than the test). A NaN energy passes; :func:`verdict` looks for its culprit.
     """
     if stretch > max_stretch:
         return OVERSTRETCH
-    flowed = held + box - drag
-    if abs(energy - e0 - flowed) > of_scale * scale + of_flows * (abs(held) + abs(box) + drag):
+    if abs(energy - e0 - flowed) > of_scale * scale + of_flows * moved:
         return RUNAWAY_ENERGY
     return OK
 
@@ -82,8 +95,9 @@ def verdict(energy, stretch, node, x, v, ledger, limits):
             bad = first_non_finite(v)
         if bad >= 0:
             return NON_FINITE, bad
-    status = balance_status(energy, stretch, ledger[HELD], ledger[BOX], ledger[DRAG], ledger[E0], ledger[SCALE],
-                            limits[0], limits[1], limits[2])
+    flowed, moved = flows(ledger)
+    status = balance_status(energy, stretch, flowed, moved, ledger[E0], ledger[SCALE], limits[0], limits[1],
+                            limits[2])
     if status == OVERSTRETCH:
         return status, node
     if status == RUNAWAY_ENERGY:
@@ -156,6 +170,11 @@ def end_step(done, schedule, x, v, mass, params, ledger, limits, frames, frame):
 def due(done, schedule):
     """True when global step ``done`` needs the end-of-step work (a check or a frame)."""
     return done % schedule.check_every == 0 or done % schedule.save_every == 0 or done == schedule.total_steps
+
+
+def net_flow(ledger) -> float:
+    """The energy that flowed in, net [J] (:func:`flows` without compiling)."""
+    return float(ledger[HELD] + ledger[BOX] - ledger[DRAG] + ledger[FLUID] + ledger[INTERNAL] + ledger[SEABED])
 
 
 # ------------------------------------------------------------------------- the limits, set up in Python

@@ -49,10 +49,11 @@ their kinetic energy at t = 0 [J], whether any free node has drag, and the check
 
 def applies(model, scheme) -> bool:
     """True when ``model`` stepped by the splitting ``scheme`` can take the plain stage: a 2-D rope whose only
-    force terms are its springs and gravity."""
+    force terms are its springs (that push as well as pull) and gravity."""
     flags = model.params.flags
     others = [f for f in range(N_FLAGS) if f != GRAVITY]
-    return model.dim == 2 and model.nodes >= 2 and not any(flags[f] for f in others)
+    return (model.dim == 2 and model.nodes >= 2 and not any(flags[f] for f in others)
+            and model.scene.rope.compression)
 
 
 def plain_bundle(model, decay: np.ndarray, gain: np.ndarray, travel: np.ndarray) -> Plain:

@@ -17,9 +17,9 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ..model.terms import accelerations, any_applied, applied_accelerations, has_applied
+from ..model.terms import ADDED_MASS, accelerations, added_mass, any_applied, applied_accelerations
 from .base import Integrator, Method
-from .health import BOX, DRAG, HELD, OK, due, end_step, held_power, place_held, power
+from .health import BOX, DRAG, FLUID, HELD, INTERNAL, OK, due, end_step, held_power, place_held, power
 
 
 @dataclass(frozen=True)
@@ -87,7 +87,6 @@ class RungeKuttaFamily(Integrator):
         self.scratch = RKScratch(np.zeros(shape), np.zeros(shape), np.zeros((stages,) + shape),
                                  np.zeros((stages,) + shape), np.zeros(shape), np.zeros(shape))
         self.gamma = np.where(model.held, 0.0, model.drag / model.mass)
-        self.has_box = has_applied(model.params)
 
     @property
     def force_evaluations(self) -> int:
@@ -134,19 +133,23 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
             for j in range(held_idx.shape[0]):
                 for d in range(dim):
                     vs[d, held_idx[j]] = held_v[d, j]
-            accelerations(xs, vs, acc, params)
+            fluid, internal = accelerations(xs, vs, acc, params, t + c[st] * h)
             lost = 0.0
             for d in range(dim):
                 for i in range(n):
                     kx[st, d, i] = vs[d, i]
                     kv[st, d, i] = acc[d, i] - gamma[i] * vs[d, i]
                     lost += gamma[i] * mass[i] * vs[d, i] * vs[d, i]
+            if params.flags[ADDED_MASS]:
+                fluid += added_mass(xs, vs, kv[st], params)
             for j in range(held_idx.shape[0]):
                 for d in range(dim):
                     kv[st, d, held_idx[j]] = 0.0
             wh = b[st] * h
             ledger[DRAG] += wh * lost
             ledger[HELD] += wh * held_power(acc, mass, held_idx, held_v)
+            ledger[FLUID] += wh * fluid
+            ledger[INTERNAL] += wh * internal
             if has_box:
                 applied_accelerations(xs, vs, acc_box, params)
                 ledger[BOX] += wh * power(acc_box, vs, mass)

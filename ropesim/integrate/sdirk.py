@@ -31,11 +31,12 @@ import numpy as np
 from numba import njit
 
 from ..model.jacobian import Jacobian, band_width
-from ..model.terms import accelerations, any_applied, applied_accelerations, coupling_jacobian, coupling_reach
-from ..model.terms import node_jacobian
+from ..model.forces.added_mass import added_mass_times
+from ..model.terms import (ADDED_MASS, accelerations, added_mass, any_applied, applied_accelerations, coupling_jacobian,
+                           coupling_reach, node_jacobian)
 from .banded import factor, solve, woodbury
 from .base import Integrator, Method
-from .health import BOX, DRAG, HELD, NEWTON_FAILED, OK, due, end_step, held_power, place_held, power
+from .health import BOX, DRAG, FLUID, HELD, INTERNAL, NEWTON_FAILED, OK, due, end_step, held_power, place_held, power
 
 GAMMA = 1.0 - 1.0 / math.sqrt(2.0)
 NEWTON_TOL = 1e-11      # Newton stops when no free node's position changes by more than this times l
@@ -86,8 +87,8 @@ Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol"])
 """The Newton solve's matrix (:class:`~ropesim.model.jacobian.Jacobian`), Woodbury arrays, right-hand side
 (N D,), whether the loop wraps around, and the tolerance [m] on the largest position update."""
 
-Stage = namedtuple("Stage", ["xh", "vh", "X", "V", "acc", "acc_box"])
-"""A stage's known part (xh, vh), its unknowns (X, V) and the accelerations there, all (D, N)."""
+Stage = namedtuple("Stage", ["xh", "vh", "X", "V", "acc", "acc_box", "tmp"])
+"""A stage's known part (xh, vh), its unknowns (X, V), the accelerations there and scratch, all (D, N)."""
 
 Nodes = namedtuple("Nodes", ["free", "mass", "drag"])
 """Per node: free (not held), mass [kg], linear drag b [kg/s] (0 at held nodes)."""
@@ -122,14 +123,14 @@ class SdirkFamily(Integrator):
 
 
 @njit(cache=True, error_model="numpy")
-def assemble(X, V, jac, beta, nodes, params):
+def assemble(X, V, jac, beta, nodes, params, t):
     """The Newton matrix M (1 + beta gamma) + beta^2 H + beta C_v into ``jac`` (see the module doc)."""
     free, mass, drag = nodes
     band, corner = jac.band, jac.corner
     dim, n = X.shape
     band[:] = 0.0
     corner[:] = 0.0
-    coupling_jacobian(X, jac, beta * beta, free, params)
+    coupling_jacobian(X, jac, beta, free, params)
     for i in range(n):
         if not free[i]:
             for d in range(dim):
@@ -140,14 +141,16 @@ def assemble(X, V, jac, beta, nodes, params):
         diag = mass[i] + beta * drag[i]
         for d in range(dim):
             band[0, i * dim + d] += diag
-    node_jacobian(X, V, band, beta, mass, free, params)
+    node_jacobian(X, V, band, beta, mass, free, params, t)
 
 
 @njit(cache=True, error_model="numpy")
 def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     """Newton solve of one stage: X = xh + beta V, V = vh + beta (a(X, V) - gamma V). Returns
-    (iterations, node): iterations < 0 when it failed, naming the node that moved most in the last one."""
-    xh, vh, X, V, acc, _ = stage
+    (iterations, node, fluid power [W], internal-damping power [W]): iterations < 0 when it failed, naming the
+    node that moved most in the last one. With added mass the stage's equation is M (V - vh) = beta (F - b V),
+    M = m I + A per node (:mod:`ropesim.model.forces.added_mass`)."""
+    xh, vh, X, V, acc = stage.xh, stage.vh, stage.X, stage.V, stage.acc
     held_idx, held_x0, held_v = held
     free, mass, drag = nodes
     band, rhs = newton.jac.band, newton.rhs
@@ -158,6 +161,8 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
             X[d, i] = xh[d, i] + beta * vh[d, i]
     place_held(X, held_idx, held_x0, held_v, t_stage)
     worst_node = -1
+    inertial = params.flags[ADDED_MASS] != 0
+    closed = params.spring[2] != 0.0
     for it in range(NEWTON_MAX_ITER):
         for d in range(dim):
             for i in range(n):
@@ -165,7 +170,7 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
         for j in range(held_idx.shape[0]):
             for d in range(dim):
                 V[d, held_idx[j]] = held_v[d, j]
-        accelerations(X, V, acc, params)
+        fluid, internal = accelerations(X, V, acc, params, t_stage)
         for i in range(n):
             for d in range(dim):
                 u = i * dim + d
@@ -175,9 +180,16 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
                                - beta * beta * m * acc[d, i])
                 else:
                     rhs[u] = 0.0
-        assemble(X, V, newton.jac, beta, nodes, params)
+            if inertial and free[i]:   # + A_i (X - xh - beta vh)
+                w0 = X[0, i] - xh[0, i] - beta * vh[0, i]
+                w1 = X[1, i] - xh[1, i] - beta * vh[1, i]
+                w2 = X[2, i] - xh[2, i] - beta * vh[2, i] if dim == 3 else 0.0
+                extra = added_mass_times(X, i, w0, w1, w2, params.added_mass, closed)
+                for d in range(dim):
+                    rhs[i * dim + d] -= extra[d]
+        assemble(X, V, newton.jac, beta, nodes, params, t_stage)
         if not factor(band, newton.jac.corner, newton.cyclic, p, newton.wood):
-            return -1, 0
+            return -1, 0, 0.0, 0.0
         solve(band, newton.jac.corner, newton.cyclic, p, rhs, newton.wood)
         worst = 0.0
         for i in range(n):
@@ -192,8 +204,8 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
                 for i in range(n):
                     if free[i]:
                         V[d, i] = (X[d, i] - xh[d, i]) / beta
-            return it + 1, -1
-    return -1, worst_node
+            return it + 1, -1, fluid, internal
+    return -1, worst_node, 0.0, 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -204,7 +216,7 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
     (steps done, frames written, status, node).
     """
     x, v, ledger, stats = state
-    xh, vh, X, V, acc, acc_box = stage
+    xh, vh, X, V, acc, acc_box, tmp = stage
     held_idx, held_x0, held_v = held
     free, mass, drag = nodes
     h = schedule.h
@@ -221,7 +233,7 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
                 vh[d, i] = v[d, i]
         for k in range(2):
             t_stage = t + (GAMMA if k == 0 else 1.0) * h
-            its, node = solve_stage(stage, newton, beta, t_stage, held, nodes, params)
+            its, node, fluid, internal = solve_stage(stage, newton, beta, t_stage, held, nodes, params)
             if its < 0:
                 return s, frame, NEWTON_FAILED, node
             stats[0] += its
@@ -232,6 +244,13 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
                     lost += drag[i] * V[d, i] * V[d, i]
             ledger[DRAG] += weight * lost
             ledger[HELD] += weight * held_power(acc, mass, held_idx, held_v)
+            if params.flags[ADDED_MASS]:   # the fluid's inertial force, m a - F, at the stage
+                for d in range(dim):
+                    for i in range(n):
+                        tmp[d, i] = acc[d, i] - drag[i] * V[d, i] / mass[i]
+                fluid += added_mass(X, V, tmp, params)
+            ledger[FLUID] += weight * fluid
+            ledger[INTERNAL] += weight * internal
             if has_box:
                 applied_accelerations(X, V, acc_box, params)
                 ledger[BOX] += weight * power(acc_box, V, mass)

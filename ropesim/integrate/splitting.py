@@ -30,12 +30,14 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ..model.terms import GRAVITY, accelerations, applied_accelerations, mechanical_energy
+from ..model.terms import GRAVITY, accelerations, has_applied, applied_accelerations, mechanical_energy, position_accelerations
 from .base import Integrator, Method
 from .contact import exact_contact_kicks
-from .health import BOX, DRAG, E0, HELD, OK, SCALE, balance_status, save_frame, verdict
+from .health import (BOX, DRAG, E0, FLUID, HELD, INTERNAL, OK, SCALE, balance_status, flows, save_frame,
+                     verdict)
 from .kick import box_work, kick_drift
 from .plain import BULK_FIXED, BULK_PER_STAGE, applies, chain_energy, inactive_bundle, plain_bundle, settle_drag
+from .velocity_kick import velocity_kick, velocity_scratch
 
 
 @dataclass(frozen=True)
@@ -154,9 +156,12 @@ per-node work (N,)."""
 Kicks = namedtuple("Kicks", ["drift", "kick", "decay", "gain", "travel", "reuse_force"])
 """The scheme's drift and kick coefficients and the exact drag kick's factors (stages, N) per node."""
 
-General = namedtuple("General", ["acc_box", "has_box", "exact", "free", "gamma", "v_contact", "contact_nodes", "buf"])
+General = namedtuple("General", ["acc_box", "has_box", "exact", "free", "gamma", "v_contact", "contact_nodes", "buf",
+                                 "velocity", "vscratch"])
 """The general stage's scratch: the applied terms' accelerations (D, N) and whether any is on; the exact
-contact kicks (on or off, free nodes, drag rates b/m, their velocities (D, N) and node list); kick scratch."""
+contact kicks (on or off, free nodes, drag rates b/m, their velocities (D, N) and node list); kick scratch;
+whether forces beyond the thrower's and guides' depend on velocity (the kick is then
+:func:`ropesim.integrate.velocity_kick.velocity_kick`) and its scratch."""
 
 
 class Splitting(Integrator):
@@ -177,10 +182,11 @@ class Splitting(Integrator):
         self.have_acc = np.zeros(1, dtype=np.bool_)
         self.spring_forces = np.zeros((2, model.nodes + 1) if plain else (2, 1))
         self.lost = np.zeros(model.nodes if plain else 0)
-        self.general = General(np.zeros_like(self.x), model.velocity_dependent,
-                               model.smooth_contacts and model.velocity_dependent, np.ascontiguousarray(~model.held),
-                               np.where(model.held, 0.0, model.drag / model.mass), np.zeros_like(self.x),
-                               np.zeros(model.nodes, dtype=np.int64), np.empty(model.nodes))
+        has_box = has_applied(model.params)
+        self.general = General(np.zeros_like(self.x), has_box, model.smooth_contacts and has_box,
+                               np.ascontiguousarray(~model.held), np.where(model.held, 0.0, model.drag / model.mass),
+                               np.zeros_like(self.x), np.zeros(model.nodes, dtype=np.int64), np.empty(model.nodes),
+                               model.velocity_terms, velocity_scratch(*self.x.shape))
         self.bundle = SplittingState(self.x, self.v, self.acc, self.have_acc, self.ledger, self.spring_forces,
                                      self.lost)
 
@@ -191,7 +197,7 @@ class Splitting(Integrator):
     def set_exact_contacts(self, on: bool) -> None:
         """Kick nodes touching the box or a circle exactly (``on``) or plainly, whatever the edges (for the
         accuracy study; by default the kick is exact when the edges are smoothed)."""
-        self.general = self.general._replace(exact=bool(on) and self.model.velocity_dependent)
+        self.general = self.general._replace(exact=bool(on) and self.general.has_box)
 
     @property
     def force_evaluations(self) -> int:
@@ -331,10 +337,24 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
                     p -= mass[i] * ay * held_v[1, j]
                     vx[i] = held_v[0, j]
                     vy[i] = held_v[1, j]
+            elif general.velocity:
+                # ---- velocity-dependent forces: RK4 sub-stages at frozen positions, the ledger by the same rule
+                position_accelerations(x, acc, params)
+                loss, supports, box, fluid, internal = velocity_kick(x, v, acc, kick[st] * h, t, params, mass,
+                                                                     general.gamma, held, general.vscratch)
+                ledger[DRAG] += loss
+                ledger[BOX] += box
+                ledger[FLUID] += fluid
+                ledger[INTERNAL] += internal
+                held_work += supports
+                if ch != 0.0:
+                    for d in range(dim):
+                        for i in range(n):
+                            x[d, i] += ch * v[d, i]
             else:
                 # ---- the general stage: every term through the term list, the kick and its ledger per node
                 if fresh:
-                    accelerations(x, v, acc, params)
+                    accelerations(x, v, acc, params, t)
                 box = 0.0
                 if general.has_box:
                     applied_accelerations(x, v, general.acc_box, params)
@@ -387,8 +407,9 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
             energy, stretch, worst = chain_energy(x, v, mass, k_spring, rest, closed, g, plain.lengths, plain.terms)
         else:
             energy, stretch, worst = mechanical_energy(x, v, mass, params)
-        status = balance_status(energy, stretch, held_work, ledger[BOX], ledger[DRAG], ledger[E0], ledger[SCALE],
-                                limits[0], limits[1], limits[2])
+        flowed, moved = flows(ledger)
+        status = balance_status(energy, stretch, flowed, moved, ledger[E0], ledger[SCALE], limits[0], limits[1],
+                                limits[2])
         if status != OK or not np.isfinite(energy):   # only now hand the arrays over, to name the culprit
             status, node = verdict(energy, stretch, worst, x, v, ledger, limits)
             if status != OK:

@@ -3,6 +3,11 @@
 Nothing here steps time: it lays out the initial state (shape (D, N), structure of arrays), the per-node
 masses and drag coefficients, the held (pinned or driven) nodes, and the force terms' parameters and flags
 (:func:`ropesim.model.terms.model_params`).
+
+Node masses: the rope's ``mass`` per node; in physical units an open line's two end nodes carry half of it
+(half a segment, as lumped-mass cable codes do); then ``[[overrides]]`` set a node's mass, and a body adds its
+own. Each node's share of unstretched length L (what drag, buoyancy and added mass act on) is half of each
+segment it touches, in either form.
 """
 
 from __future__ import annotations
@@ -12,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..scene import schema as S
-from .terms import ModelParams, has_applied, model_params
+from ..scene.shapes import initial_positions
+from .terms import Layout, ModelParams, has_applied, model_params, velocity_terms_on
 
 
 @dataclass
@@ -40,8 +46,14 @@ class Model:
 
     @property
     def velocity_dependent(self) -> bool:
-        """True when a force other than drag depends on velocity (the thrower and guide circles)."""
-        return has_applied(self.params)
+        """True when a force other than the linear [drag] depends on velocity (the thrower, the guide circles,
+        fluid drag, axial damping, added mass)."""
+        return has_applied(self.params) or self.velocity_terms
+
+    @property
+    def velocity_terms(self) -> bool:
+        """True when a term beyond the thrower's and guides' depends on velocity (see Term.velocity)."""
+        return velocity_terms_on(self.params)
 
     @property
     def has_drag(self) -> bool:
@@ -64,6 +76,8 @@ def build(scene: S.Scene) -> Model:
     v0[:] = np.asarray(scene.initial.velocity, dtype=float)[:, None]
 
     mass = np.full(n, scene.rope.mass)
+    if scene.rope.physical and not scene.rope.closed:
+        mass[[0, -1]] *= 0.5
     drag = np.full(n, scene.drag.b if scene.drag is not None else 0.0)
     for o in scene.overrides:
         i = scene.node(o.index)
@@ -71,6 +85,8 @@ def build(scene: S.Scene) -> Model:
             mass[i] = o.mass
         if o.drag is not None:
             drag[i] = o.drag
+    for body in scene.bodies:
+        mass[scene.node(body.node)] += body.mass
 
     held_v = np.zeros((dim, n))
     held = np.zeros(n, dtype=bool)
@@ -83,48 +99,19 @@ def build(scene: S.Scene) -> Model:
     held_idx = np.flatnonzero(held).astype(np.int64)
     v0[:, held_idx] = held_v[:, held_idx]
 
+    layout = Layout(mass, held, node_lengths(scene))
     return Model(scene=scene, x0=x0, v0=v0, mass=mass, drag=drag, held=held, held_idx=held_idx,
                  held_x0=np.ascontiguousarray(x0[:, held_idx]), held_v=np.ascontiguousarray(held_v[:, held_idx]),
-                 params=model_params(scene, mass))
+                 params=model_params(scene, layout))
 
 
-def initial_positions(scene: S.Scene) -> np.ndarray:
-    """Node positions at t = 0, shape (D, N) [m]."""
-    n, dim, l = scene.rope.nodes, scene.dimension, scene.rope.segment_length
-    init = scene.initial
-    if isinstance(init, S.HangingStart):
-        x = np.zeros((dim, n))
-        x[:] = np.asarray(init.top)[:, None]
-        x[1] -= l * np.arange(n)
-    elif isinstance(init, S.LineStart):
-        s = np.linspace(0.0, 1.0, n)
-        start, end = np.asarray(init.start), np.asarray(init.end)
-        x = (start[:, None] + (end - start)[:, None] * s[None, :])
-    elif isinstance(init, S.SquareLoopStart):
-        x = _square_loop(n, l, np.asarray(init.top_center), dim)
-    elif isinstance(init, S.PointsStart):
-        x = np.asarray(init.points, dtype=float).T
-    else:  # pragma: no cover - the loader admits only the shapes above
-        raise TypeError(type(init))
-    return np.ascontiguousarray(x, dtype=float)
-
-
-def _square_loop(n: int, l: float, top_center: np.ndarray, dim: int) -> np.ndarray:
-    """n nodes l apart along a square of perimeter n l hanging below its top edge (clockwise from top-left)."""
-    side = n * l / 4.0
-    corners = np.array([[-side / 2, 0.0], [side / 2, 0.0], [side / 2, -side], [-side / 2, -side]])
-    s = l * np.arange(n)
-    edge = np.minimum((s // side).astype(int), 3)
-    frac = (s - edge * side) / side
-    start = corners[edge]
-    end = corners[(edge + 1) % 4]
-    xy = start + (end - start) * frac[:, None]
-    x = np.zeros((dim, n))
-    x[0] = top_center[0] + xy[:, 0]
-    x[1] = top_center[1] + xy[:, 1]
-    if dim == 3:
-        x[2] = top_center[2]
-    return x
+def node_lengths(scene: S.Scene) -> np.ndarray:
+    """Each node's share of the rope's unstretched length [m]: half of each segment it touches."""
+    rope = scene.rope
+    length = np.full(rope.nodes, rope.segment_length)
+    if not rope.closed:
+        length[[0, -1]] *= 0.5
+    return length
 
 
 def spring_count(n: int, stride: int, closed: bool) -> int:

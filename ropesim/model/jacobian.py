@@ -68,11 +68,12 @@ def add_pair(jac, n, i, j, free_i, free_j):
 
 
 @njit(cache=True, error_model="numpy")
-def pair_spring_blocks(x, jac, k, rest, stride, closed, scale, free):
+def pair_spring_blocks(x, jac, k, rest, stride, closed, scale, free, slack):
     """Add ``scale`` times the stiffness of every spring (i, i + stride) of constant k [N/m] and rest length [m].
 
     A spring's stiffness block is k [(1 - g) u u^T + g I] with g = 1 - l0 / r, u its unit vector;
-    compressive (negative) geometric stiffness is left out (g >= 0), so the matrix stays positive definite.
+    compressive (negative) geometric stiffness is left out (g >= 0), so the matrix stays positive definite. A
+    ``slack`` (tension-only) spring shorter than its rest length adds nothing.
     """
     dim, n = x.shape
     blk = jac.blk
@@ -90,9 +91,35 @@ def pair_spring_blocks(x, jac, k, rest, stride, closed, scale, free):
         if r2 == 0.0:
             continue
         r = math.sqrt(r2)
+        if slack and r < rest:
+            continue
         geo = max(0.0, 1.0 - rest / r)   # compressive (negative) geometric stiffness left out: SPD
         u = ((x[0, j] - x[0, i]) / r, (x[1, j] - x[1, i]) / r, (x[2, j] - x[2, i]) / r if dim == 3 else 0.0)
         for a in range(dim):
             for b in range(dim):
                 blk[a, b] = scale * k * ((1.0 - geo) * u[a] * u[b] + (geo if a == b else 0.0))
+        add_pair(jac, n, i, j, free[i], free[j])
+
+
+@njit(cache=True, error_model="numpy")
+def pair_damper_blocks(x, jac, c, closed, scale, free):
+    """Add ``scale`` times the damping c u u^T [N s/m] of every segment (i, i + 1) (the rope's axial damping)."""
+    dim, n = x.shape
+    blk = jac.blk
+    count = n if closed else n - 1
+    for i in range(count):
+        j = i + 1 if i + 1 < n else 0
+        if not (free[i] or free[j]):
+            continue
+        r2 = 0.0
+        for d in range(dim):
+            delta = x[d, j] - x[d, i]
+            r2 += delta * delta
+        if r2 == 0.0:
+            continue
+        r = math.sqrt(r2)
+        u = ((x[0, j] - x[0, i]) / r, (x[1, j] - x[1, i]) / r, (x[2, j] - x[2, i]) / r if dim == 3 else 0.0)
+        for a in range(dim):
+            for b in range(dim):
+                blk[a, b] = scale * c * u[a] * u[b]
         add_pair(jac, n, i, j, free[i], free[j])

@@ -136,11 +136,11 @@ def scene_from_dict(raw: dict, source: str = "<scene>", default_name: str = "sce
     dim = top.get("dimension", 2)
     ctx = _Ctx(source, dim)
 
-    rope = ctx.table(raw, "rope", S.Rope)
+    rope = _resolve_rope(ctx.table(raw, "rope", S.Rope), source)
     parts: dict[str, Any] = {"rope": rope}
-    for key in ("gravity", "drag", "bending", "thrower", "pinned", "integrator", "output"):
-        if key in raw:
-            parts[key] = ctx.table(raw, key, S.TABLES[key])
+    for key, cls in S.TABLES.items():
+        if key not in ("rope", "initial") and key in raw:
+            parts[key] = ctx.table(raw, key, cls)
     for key, cls in S.ARRAYS_OF_TABLES.items():
         if key in raw:
             items = raw[key]
@@ -211,8 +211,135 @@ def _check_scene(scene: S.Scene, source: str) -> S.Scene:
     _check_name_and_length(scene, fail)
     _check_topology(scene, fail)
     _check_nodes(scene, fail)
+    _check_fluid(scene, fail)
     scene = _resolve_initial(scene, fail)
-    return _resolve_omegas(scene, fail)
+    scene = _resolve_omegas(scene, fail)
+    _check_flow_covers_the_rope(scene, fail)
+    return scene
+
+
+PER_NODE_KEYS = ("nodes", "segment_length", "stiffness", "mass")
+PHYSICAL_KEYS = ("length", "segments", "mass_per_length", "density", "EA")
+AGREE = 1e-9   # relative: a resolved scene's derived values agree with their physical form to rounding
+
+
+def _resolve_rope(rope: S.Rope, source: str) -> S.Rope:
+    """The rope with both forms filled: the per-node values derived from the physical ones when those are given
+    (and checked against any per-node values also given), the compression default set."""
+    def fail(key, message):
+        raise SceneError(source, f"rope.{key}", message)
+
+    if not any(getattr(rope, k) is not None for k in PHYSICAL_KEYS):
+        for key in PER_NODE_KEYS:
+            if getattr(rope, key) is None:
+                spec = {f.name: f.metadata["spec"] for f in fields(S.Rope)}[key]
+                fail(key, f"missing: {spec.doc}{_unit(spec)} (or give the rope in physical units: length, "
+                          f"segments, mass_per_length and EA)")
+        return replace(rope, compression=True if rope.compression is None else rope.compression)
+    for key in ("length", "EA"):
+        if getattr(rope, key) is None:
+            fail(key, f"missing: a rope in physical units needs length, EA, segments (or nodes) and "
+                      f"mass_per_length (or diameter and density)")
+    segments = rope.segments
+    from_nodes = None if rope.nodes is None else (rope.nodes if rope.closed else rope.nodes - 1)
+    if segments is None and from_nodes is None:
+        fail("segments", "missing: how many segments the rope is cut into (or give nodes)")
+    if segments is not None and from_nodes is not None and segments != from_nodes:
+        fail("nodes", f"{rope.nodes} nodes contradict segments = {segments} (a {'loop' if rope.closed else 'line'} "
+                      f"of {segments} segments has {segments if rope.closed else segments + 1} nodes)")
+    segments = segments if segments is not None else from_nodes
+    if rope.closed and segments < 3 or segments < 1:
+        fail("segments", f"a {'closed loop needs at least 3' if rope.closed else 'line needs at least 1'}, "
+                         f"got {segments}")
+    per_metre = rope.mass_per_length
+    if rope.density is not None:
+        if rope.diameter is None:
+            fail("diameter", "missing: with density, the mass per metre is density x pi d^2 / 4")
+        from_density = rope.density * math.pi * rope.diameter ** 2 / 4.0
+        if per_metre is not None and not _agree(per_metre, from_density):
+            fail("mass_per_length", f"{per_metre:g} kg/m contradicts density x pi d^2 / 4 = {from_density:g} kg/m; "
+                                    f"give one of them")
+        per_metre = from_density if per_metre is None else per_metre
+    if per_metre is None:
+        fail("mass_per_length", "missing: give mass_per_length, or diameter and density")
+    l0 = rope.length / segments
+    derived = {"nodes": segments if rope.closed else segments + 1, "segment_length": l0,
+               "stiffness": rope.EA / l0, "mass": per_metre * l0}
+    for key, value in derived.items():
+        given = getattr(rope, key)
+        if given is not None and not _agree(given, value):
+            fail(key, f"{given:g} contradicts the physical form, which gives {value:g}; give one form, or both "
+                      f"consistently")
+    return replace(rope, segments=segments, mass_per_length=per_metre,
+                   compression=False if rope.compression is None else rope.compression, **derived)
+
+
+def _agree(a: float, b: float) -> bool:
+    return abs(a - b) <= AGREE * max(abs(a), abs(b))
+
+
+def _check_fluid(scene: S.Scene, fail) -> None:
+    """The fluid terms have what they act with: a fluid, a diameter, gravity for buoyancy, a drag for a flow."""
+    needs_fluid = [k for k in ("fluid_drag", "buoyancy", "added_mass") if getattr(scene, k) is not None]
+    if any(b.volume > 0 or b.cd_area > 0 for b in scene.bodies):
+        needs_fluid.append("bodies")
+    if needs_fluid and scene.fluid is None:
+        fail(needs_fluid[0], "needs a [fluid] table with the fluid's density (air 1.225, sea water 1025 kg/m^3)")
+    for key in ("fluid_drag", "buoyancy", "added_mass"):
+        if getattr(scene, key) is not None and scene.rope.diameter is None:
+            fail("rope.diameter", f"missing: [{key}] acts on the rope's diameter")
+    if scene.buoyancy is not None and scene.gravity is None:
+        fail("buoyancy", "needs [gravity]: buoyancy is the fluid's weight displaced")
+    drags = [k for k in ("drag", "fluid_drag", "viscous_drag") if getattr(scene, k) is not None]
+    if scene.flow is not None and not drags and not any(b.cd_area > 0 for b in scene.bodies):
+        fail("flow", "moves the rope only through drag: add [drag], [fluid_drag], [viscous_drag] or a body "
+                     "with cd_area")
+    flow = scene.flow
+    if flow is not None:
+        _check_flow(flow, scene.dimension, fail)
+    index = _node_index(scene.rope.nodes, fail)
+    seen: dict[int, str] = {}
+    for j, body in enumerate(scene.bodies):
+        node = index(f"bodies.{j}.node", body.node)
+        if node in seen:
+            fail(f"bodies.{j}.node", f"node {node} already carries {seen[node]}; give each node one body")
+        seen[node] = f"bodies.{j}"
+        if body.mass == body.volume == body.cd_area == 0.0:
+            fail(f"bodies.{j}", "has no mass, volume or cd_area; give at least one")
+        if body.ca > 0 and body.volume == 0:
+            fail(f"bodies.{j}.ca", "an added-mass coefficient needs the body's volume")
+
+
+def _check_flow(flow: S.Flow, dim: int, fail) -> None:
+    need = {"uniform": ("velocity",), "power_law": ("velocity", "reference_height", "exponent"),
+            "table": ("heights", "velocities")}[flow.profile]
+    for key in need:
+        if getattr(flow, key) is None:
+            fail(f"flow.{key}", f"missing: profile = '{flow.profile}' needs {', '.join(need)}")
+    unused = [k for k in ("velocity", "reference_height", "exponent", "heights", "velocities")
+              if k not in need and getattr(flow, k) is not None]
+    if unused:
+        fail(f"flow.{unused[0]}", f"is not used by profile = '{flow.profile}' (it uses {', '.join(need)})")
+    if flow.profile == "table":
+        if len(flow.heights) != len(flow.velocities):
+            fail("flow.velocities", f"has {len(flow.velocities)} rows but flow.heights has {len(flow.heights)}; "
+                                    f"give one velocity per height")
+        if any(b <= a for a, b in zip(flow.heights, flow.heights[1:])):
+            fail("flow.heights", f"must increase strictly, got {_show(list(flow.heights))}")
+
+
+def _check_flow_covers_the_rope(scene: S.Scene, fail) -> None:
+    """A table profile must cover the heights the rope starts at (beyond its rows the flow is held constant)."""
+    flow = scene.flow
+    if flow is None or flow.profile != "table":
+        return
+    from .shapes import initial_positions
+
+    y = initial_positions(scene)[1]
+    low, high = float(y.min()), float(y.max())
+    if low < flow.heights[0] or high > flow.heights[-1]:
+        fail("flow.heights", f"cover y = {flow.heights[0]:g} to {flow.heights[-1]:g} m, but the rope starts at "
+                             f"y = {low:g} to {high:g} m; extend the table to the rope's range")
 
 
 def _check_name_and_length(scene: S.Scene, fail) -> None:
@@ -368,6 +495,13 @@ def _value(value: Any, sp: S.Spec, key: str, source: str, dim: int):
                 isinstance(v, int) and not isinstance(v, bool) for v in value):
             bad("must be a non-empty list of node indices (integers)")
         return tuple(value)
+    if sp.kind == "float_list":
+        if not isinstance(value, list) or not value or not all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and _finite(v) for v in value):
+            bad("must be a non-empty list of finite numbers")
+        for v in value:
+            _magnitude(float(v), sp, key, source, shown=value)
+        return tuple(float(v) for v in value)
     if sp.kind == "points":
         if not isinstance(value, list) or not value:
             bad(f"must be a list of points, each a list of {dim} numbers")

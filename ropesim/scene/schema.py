@@ -21,8 +21,8 @@ from typing import Any
 class Spec:
     """What one TOML key may hold.
 
-    kind: "int", "float", "bool", "str", "vector" (one number per dimension), "int_list" or "points"
-    (a list of vectors). ``low``/``high`` bound numbers (``open_low`` makes the lower bound strict).
+    kind: "int", "float", "bool", "str", "vector" (one number per dimension), "int_list", "float_list" or
+    "points" (a list of vectors). ``low``/``high`` bound numbers (``open_low`` makes the lower bound strict).
     """
 
     kind: str
@@ -49,13 +49,55 @@ def spec(kind: str, doc: str, unit: str = "", default: Any = None, required: boo
 
 @dataclass(frozen=True)
 class Rope:
-    """N point masses joined by springs of stiffness k and rest length l; an open line or a closed loop."""
+    """N point masses joined by springs; an open line or a closed loop. Two ways to give it:
 
-    nodes: int = spec("int", "number of point masses N", low=2, high=1_000_000)
-    segment_length: float = spec("float", "rest length l of each spring", "m", low=0, open_low=True)
-    stiffness: float = spec("float", "spring constant k between neighbours", "N/m", low=0, open_low=True)
-    mass: float = spec("float", "mass m of each node", "kg", low=0, open_low=True)
+    - per node (the course's form): ``nodes``, ``segment_length`` l, ``stiffness`` k and ``mass`` m of each node;
+    - in physical units: ``length``, ``segments`` (or ``nodes``), ``mass_per_length`` (or ``diameter`` and
+      material ``density``) and the axial stiffness ``EA``. The loader derives l = length / segments,
+      k = EA / l and the node masses, lumped as cable codes do: each node carries half of each segment it
+      touches, so an open line's two end nodes carry half a segment (MoorDyn's convention). The resolved
+      scene shows both forms.
+
+    ``axial_damping`` (BA) adds a force BA (dl/dt) / l along each segment, in tension and compression.
+    ``compression = false`` makes segments slack when shorter than their rest length (a real rope; the
+    default in physical units), ``true`` makes them push back (the course's springs; the per-node default).
+    ``diameter`` (either form) is what fluid drag, buoyancy and added mass act on.
+    """
+
+    nodes: int | None = spec("int", "number of point masses N (physical form: segments + 1 on a line, segments "
+                                    "on a loop)", default=None, required=False, low=2, high=1_000_000)
+    segment_length: float | None = spec("float", "rest length l of each segment", "m", default=None, required=False,
+                                        low=0, open_low=True)
+    stiffness: float | None = spec("float", "spring constant k of each segment (physical form: EA / l)", "N/m",
+                                   default=None, required=False, low=0, open_low=True)
+    mass: float | None = spec("float", "mass m of each node (physical form: mass_per_length l; an open line's "
+                                       "ends carry half)", "kg", default=None, required=False, low=0, open_low=True)
     closed: bool = spec("bool", "true for a closed loop (the last node joins the first)", default=False)
+    length: float | None = spec("float", "unstretched length of the whole rope (physical form)", "m", default=None,
+                                required=False, low=0, open_low=True)
+    segments: int | None = spec("int", "number of segments (physical form)", default=None, required=False, low=1,
+                                high=1_000_000)
+    mass_per_length: float | None = spec("float", "mass per metre (physical form)", "kg/m", default=None,
+                                         required=False, low=0, open_low=True)
+    diameter: float | None = spec("float", "diameter d: the area drag, buoyancy and added mass act on", "m",
+                                  default=None, required=False, low=0, open_low=True)
+    density: float | None = spec("float", "material density; with diameter, the mass per metre rho pi d^2 / 4",
+                                 "kg/m^3", default=None, required=False, low=0, open_low=True)
+    EA: float | None = spec("float", "axial stiffness EA (physical form)", "N", default=None, required=False, low=0,
+                            open_low=True)
+    axial_damping: float | None = spec("float", "internal damping BA: force BA (dl/dt) / l along each segment",
+                                       "N s", default=None, required=False, low=0)
+    compression: bool | None = spec("bool", "segments push back when shorter than their rest length (default: "
+                                            "true per node, false in physical units)", default=None, required=False)
+
+    @property
+    def physical(self) -> bool:
+        """True when the rope was given in physical units (its end nodes then carry half a segment)."""
+        return self.length is not None
+
+    @property
+    def segment_count(self) -> int:
+        return self.nodes if self.closed else self.nodes - 1
 
 
 @dataclass(frozen=True)
@@ -75,9 +117,105 @@ class Gravity:
 
 @dataclass(frozen=True)
 class Drag:
-    """Linear air drag F = -b v on every node (still air)."""
+    """Linear drag F = -b (v - U) on every node, U the ambient flow ([flow]; still air without one)."""
 
     b: float = spec("float", "drag coefficient of each node", "kg/s", low=0)
+
+
+# ------------------------------------------------------------------------------------ fluid and flow
+
+
+@dataclass(frozen=True)
+class Fluid:
+    """The fluid the rope moves in (air, water): needed by fluid drag, buoyancy and added mass."""
+
+    density: float = spec("float", "fluid density (air 1.225, sea water 1025)", "kg/m^3", low=0, open_low=True)
+
+
+@dataclass(frozen=True)
+class Flow:
+    """The ambient fluid velocity U (wind, current) that drag acts on, a function of height y:
+
+    - ``profile = "uniform"``: U = ``velocity`` everywhere;
+    - ``"power_law"``: U = ``velocity`` ((y - datum) / reference_height)^exponent above the datum (ground or
+      seabed), 0 below it;
+    - ``"table"``: U interpolated linearly between the rows of ``heights`` (y, increasing) and ``velocities``,
+      held at the end rows beyond them (the rope must start inside the table).
+
+    With ``ramp_time`` > 0 the flow grows smoothly from 0, times (1 - cos(pi t / ramp_time)) / 2, and is
+    whole from t = ramp_time on.
+    """
+
+    profile: str = spec("str", "how the flow varies with height", default="uniform",
+                        choices=("uniform", "power_law", "table"))
+    velocity: tuple | None = spec("vector", "flow velocity (uniform), or at the reference height (power_law)",
+                                  "m/s", default=None, required=False)
+    reference_height: float | None = spec("float", "power_law: height above the datum where U = velocity", "m",
+                                          default=None, required=False, low=0, open_low=True)
+    exponent: float | None = spec("float", "power_law: the exponent (wind over open ground ~0.14, tidal current "
+                                           "~1/7)", default=None, required=False, low=0)
+    datum: float = spec("float", "power_law: the y of the ground or seabed", "m", default=0.0)
+    heights: tuple | None = spec("float_list", "table: heights y, increasing", "m", default=None, required=False)
+    velocities: tuple | None = spec("points", "table: the flow velocity at each height", "m/s", default=None,
+                                    required=False)
+    ramp_time: float = spec("float", "time over which the flow ramps up from zero (0: at once)", "s", default=0.0,
+                            low=0)
+
+
+@dataclass(frozen=True)
+class FluidDrag:
+    """Morison-type quadratic drag on the velocity relative to the flow, u = v - U, per node, split along the
+    node's tangent q (the chord through its two neighbours; the end segment at an open line's ends):
+
+        F = -1/2 rho Cd_n d L |u_n| u_n - 1/2 rho Cd_t pi d L |u_t| u_t,
+
+    L the node's share of unstretched length (half of each adjacent segment), d the rope's diameter: the
+    normal part on the projected area d L, the tangential part on the skin pi d L (MoorDyn's Cd and CdAx).
+    """
+
+    cd_normal: float = spec("float", "normal drag coefficient Cd_n (a cylinder across the flow: about 1.2)",
+                            low=0)
+    cd_tangential: float = spec("float", "tangential (skin) drag coefficient Cd_t (about 0.01 to 0.02 for a rope "
+                                         "in water, up to ~0.1 measured for strings in air)", default=0.0, low=0)
+
+
+@dataclass(frozen=True)
+class ViscousDrag:
+    """Linear drag per metre of rope, split along the node tangent: F = -b_n L u_n - b_t L u_t (u = v - U,
+    L the node's share of length). For slow, viscous flow or fitted to experiments; b_n = b_t = b / l is the
+    isotropic [drag] b of an inner node."""
+
+    b_normal: float = spec("float", "normal drag per metre", "N s/m^2", low=0)
+    b_tangential: float = spec("float", "tangential drag per metre", "N s/m^2", low=0)
+
+
+@dataclass(frozen=True)
+class Buoyancy:
+    """The fluid's upward push, fluid density times displaced volume (pi d^2 / 4 per metre of unstretched rope,
+    plus each body's volume) times g. Needs [fluid], [gravity] and rope.diameter; no keys."""
+
+
+@dataclass(frozen=True)
+class AddedMass:
+    """The fluid the rope drags along when it accelerates: per node the mass matrix
+    m I + rho V [Ca_n (I - q q^T) + Ca_t q q^T] (V the displaced volume, q the node tangent; MoorDyn's Ca and
+    CaAx), so a = M^-1 F."""
+
+    ca_normal: float = spec("float", "normal added-mass coefficient Ca_n (a cylinder: 1)", low=0)
+    ca_tangential: float = spec("float", "tangential added-mass coefficient Ca_t (usually 0)", default=0.0, low=0)
+
+
+@dataclass(frozen=True)
+class Body:
+    """A point body carried by one node (an end mass, a hook, a parachute): its mass joins the node's, and it
+    adds buoyancy rho V g, quadratic drag -1/2 rho CdA |u| u on the velocity relative to the flow, and added
+    mass rho Ca V (the same in every direction)."""
+
+    node: int = spec("int", "the node carrying it; negative counts from the end (-1 is the last node)")
+    mass: float = spec("float", "its mass, added to the node's", "kg", default=0.0, low=0)
+    volume: float = spec("float", "its displaced volume (buoyancy, added mass)", "m^3", default=0.0, low=0)
+    cd_area: float = spec("float", "its drag coefficient times area, CdA", "m^2", default=0.0, low=0)
+    ca: float = spec("float", "its added-mass coefficient", default=0.0, low=0)
 
 
 # -------------------------------------------------------------------------------- initial shapes
@@ -248,12 +386,19 @@ class Scene:
     description: str = ""
     gravity: Gravity | None = None
     drag: Drag | None = None
+    fluid: Fluid | None = None
+    flow: Flow | None = None
+    fluid_drag: FluidDrag | None = None
+    viscous_drag: ViscousDrag | None = None
+    buoyancy: Buoyancy | None = None
+    added_mass: AddedMass | None = None
     bending: Bending | None = None
     thrower: Thrower | None = None
     guides: tuple[Guide, ...] = ()
     pinned: Pinned | None = None
     driven: tuple[Driven, ...] = ()
     overrides: tuple[NodeOverride, ...] = ()
+    bodies: tuple[Body, ...] = ()
 
     def node(self, index: int) -> int:
         """The non-negative index of ``index`` (negative counts from the end)."""
@@ -271,13 +416,19 @@ TABLES = {
     "initial": None,  # a tagged union: initial.shape chooses one of INITIAL_SHAPES
     "gravity": Gravity,
     "drag": Drag,
+    "fluid": Fluid,
+    "flow": Flow,
+    "fluid_drag": FluidDrag,
+    "viscous_drag": ViscousDrag,
+    "buoyancy": Buoyancy,
+    "added_mass": AddedMass,
     "bending": Bending,
     "thrower": Thrower,
     "pinned": Pinned,
     "integrator": Integrator,
     "output": Output,
 }
-ARRAYS_OF_TABLES = {"guides": Guide, "driven": Driven, "overrides": NodeOverride}
+ARRAYS_OF_TABLES = {"guides": Guide, "driven": Driven, "overrides": NodeOverride, "bodies": Body}
 REQUIRED_TABLES = ("rope", "initial", "integrator")
 
 

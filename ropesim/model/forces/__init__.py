@@ -42,8 +42,13 @@ class Term:
     - ``node_stiffness(model)``: the largest omega^2 [1/s^2] the term adds to a single node (a centring spring);
     - ``damping(model)``: the largest velocity-damping rate [1/s] the term applies, which explicit methods
       must resolve;
-    - ``applied``: True for a non-conservative term whose work the ledger books in its ``box_work`` column
-      (its acceleration is part of :func:`ropesim.model.terms.applied_accelerations`);
+    - ``ledger``: for a non-conservative term, the energy ledger's column that books its work: "box" (the
+      thrower and guides: :func:`ropesim.model.terms.applied_accelerations`), "fluid" (drag on the velocity
+      relative to the flow, added mass) or "internal" (the rope's axial damping); None for a conservative term;
+    - ``velocity``: True when its force depends on the velocities (the splitting schemes then integrate their
+      kicks with RK4 sub-steps, see :mod:`ropesim.integrate.velocity_kick`), except the thrower's and guides',
+      which keep their own exact or plain kicks;
+    - ``active(scene)``: whether the scene switches the term on, when that is more than declaring its table;
     - ``reach``: how many places along the rope the term couples nodes (0 for a node-local term), which sets
       the stiff integrator's band width; its Jacobian blocks go in through
       :func:`ropesim.model.terms.coupling_jacobian` (couplings) or :func:`ropesim.model.terms.node_jacobian`
@@ -58,11 +63,17 @@ class Term:
     springs: Callable = _none
     node_stiffness: Callable = _zero
     damping: Callable = _zero
-    applied: bool = False
+    ledger: str | None = None
+    velocity: bool = False
     label: str = ""                             # its energy's name in energy_terms (default: ``name``)
     reach: int = 0
+    active: Callable | None = None
 
     def declared(self, scene) -> bool:
-        """True when ``scene`` declares this term (or the term is always on)."""
+        """True when ``scene`` switches this term on (or the term is always on)."""
+        if self.flag is None:
+            return True
+        if self.active is not None:
+            return bool(self.active(scene))
         part = getattr(scene, self.name)
-        return self.flag is None or (part is not None and part != ())
+        return part is not None and part != ()

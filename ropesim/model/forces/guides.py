@@ -118,4 +118,4 @@ def _omega0(model, guide) -> float:
 GUIDES = Term("guides", 3, _params, lambda: np.zeros((0, GUIDE_PARAMS)),
               node_stiffness=lambda model: max(_omega0(model, g) * _omega0(model, g) for g in model.scene.guides),
               damping=lambda model: max(2 * g.damping_ratio * _omega0(model, g) for g in model.scene.guides),
-              applied=True)
+              ledger="box")

@@ -135,4 +135,4 @@ def _damping(model) -> float:
 
 
 THROWER = Term("thrower", 2, _params, lambda: np.zeros(THROWER_PARAMS),
-               node_stiffness=lambda model: model.scene.thrower.resolved_omega0 * model.scene.thrower.resolved_omega0, damping=_damping, applied=True)
+               node_stiffness=lambda model: model.scene.thrower.resolved_omega0 * model.scene.thrower.resolved_omega0, damping=_damping, ledger="box")

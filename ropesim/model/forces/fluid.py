@@ -1,0 +1,285 @@
+"""Fluid forces on the velocity relative to an ambient flow: Morison-type quadratic drag, linear anisotropic
+drag, point bodies' drag, and the flow's push on the linear [drag] b.
+
+The flow U(y, t) (``[flow]``) is uniform, a power law over height above a datum, or a table over height
+interpolated linearly (held at its end rows beyond them), times a smooth ramp (1 - cos(pi t / T)) / 2 over
+the first T = ``ramp_time`` seconds. With u = v - U the relative velocity of node i, split along the node
+tangent q_i (the unit chord through its two neighbours, x_(i+1) - x_(i-1); at an open line's ends the end
+segment's direction; MoorDyn's convention) into u_t = (u . q) q and u_n = u - u_t:
+
+- quadratic drag (``[fluid_drag]``): F = -c_n L |u_n| u_n - c_t L |u_t| u_t, c_n = rho Cd_n d / 2 on the
+  projected area, c_t = rho Cd_t pi d / 2 on the skin (MoorDyn's Cd and CdAx), L the node's share of
+  unstretched length (half of each adjacent segment);
+- linear drag (``[viscous_drag]``): F = -b_n L u_n - b_t L u_t;
+- a body (``[[bodies]]`` with cd_area): F = -(rho CdA / 2) |u| u;
+- the linear [drag] b in a flow: F = -b (v - U), of which the kick integrates -b v exactly; the push + b U is
+  added here.
+
+Lumping: every coefficient acts on the node's share L of *unstretched* length, as MoorDyn does (stretching
+changes neither mass nor drag area). A node whose two neighbours coincide has no tangent: all of u counts as
+normal. All of it is work of the fluid, booked in the energy ledger's ``fluid_work``.
+
+Parameters: ``fluid_drag`` [c_n, c_t] [kg/m^2], ``viscous_drag`` [b_n, b_t] [N s/m^2], ``body_drag`` (N,)
+rho CdA / 2 [kg/m], ``flow_push`` (N,) b / m [1/s], ``flow`` = (scalars [profile, ramp_time, datum,
+reference_height, exponent, Ux, Uy, Uz], table (K, 4) [y, Ux, Uy, Uz]), and the model's ``node_length`` (N,).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from . import Term
+
+FLUID_DRAG, VISCOUS_DRAG, BODY_DRAG, FLOW, FLOW_PUSH = 6, 7, 8, 9, 10   # their flags (Term.flag below)
+UNIFORM, POWER_LAW, TABLE = 0, 1, 2
+PROFILES = {"uniform": UNIFORM, "power_law": POWER_LAW, "table": TABLE}
+FLOW_PARAMS = 8
+
+
+@njit(cache=True, error_model="numpy")
+def ramp(t, ramp_time):
+    """The flow's ramp factor at time t [s]: (1 - cos(pi t / T)) / 2 until T, then 1."""
+    if ramp_time <= 0.0 or t >= ramp_time:
+        return 1.0
+    if t <= 0.0:
+        return 0.0
+    return 0.5 * (1.0 - math.cos(math.pi * t / ramp_time))
+
+
+@njit(cache=True, error_model="numpy")
+def flow_at(y, t, flow, table):
+    """The flow velocity (Ux, Uy, Uz) [m/s] at height y [m] and time t [s] (see the module doc)."""
+    s = ramp(t, flow[1])
+    kind = int(flow[0])
+    if kind == TABLE:
+        k = table.shape[0]
+        if y <= table[0, 0]:
+            return s * table[0, 1], s * table[0, 2], s * table[0, 3]
+        if y >= table[k - 1, 0]:
+            return s * table[k - 1, 1], s * table[k - 1, 2], s * table[k - 1, 3]
+        lo, hi = 0, k - 1
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            if table[mid, 0] <= y:
+                lo = mid
+            else:
+                hi = mid
+        w = (y - table[lo, 0]) / (table[hi, 0] - table[lo, 0])
+        return (s * (table[lo, 1] + w * (table[hi, 1] - table[lo, 1])),
+                s * (table[lo, 2] + w * (table[hi, 2] - table[lo, 2])),
+                s * (table[lo, 3] + w * (table[hi, 3] - table[lo, 3])))
+    if kind == POWER_LAW:
+        above = y - flow[2]
+        s = s * (above / flow[3]) ** flow[4] if above > 0.0 else 0.0
+    return s * flow[5], s * flow[6], s * flow[7]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def node_tangent(x, i, closed):
+    """The unit tangent (qx, qy, qz) of node i (see the module doc); (0, 0, 0) when it has none."""
+    dim, n = x.shape
+    lo, hi = i - 1, i + 1
+    if lo < 0:
+        lo = n - 1 if closed else 0
+    if hi >= n:
+        hi = 0 if closed else n - 1
+    qx = x[0, hi] - x[0, lo]
+    qy = x[1, hi] - x[1, lo]
+    qz = x[2, hi] - x[2, lo] if dim == 3 else 0.0
+    r = math.sqrt(qx * qx + qy * qy + qz * qz)
+    if r == 0.0:
+        return 0.0, 0.0, 0.0
+    return qx / r, qy / r, qz / r
+
+
+@njit(cache=True, error_model="numpy")
+def add_fluid_forces(x, v, acc, p, t):
+    """Add the fluid forces (see the module doc) of every free-or-held node as accelerations [m/s^2]; returns
+    their power [W] on the rope (held nodes included: their supports take it)."""
+    dim, n = x.shape
+    closed = p.spring[2] != 0.0
+    flags = p.flags
+    quadratic, linear, body, moving, push = (flags[FLUID_DRAG] != 0, flags[VISCOUS_DRAG] != 0,
+                                             flags[BODY_DRAG] != 0, flags[FLOW] != 0, flags[FLOW_PUSH] != 0)
+    c_n, c_t = p.fluid_drag[0], p.fluid_drag[1]
+    b_n, b_t = p.viscous_drag[0], p.viscous_drag[1]
+    flow, table = p.flow
+    power = 0.0
+    for i in range(n):
+        ux = uy = uz = 0.0
+        if moving:
+            ux, uy, uz = flow_at(x[1, i], t, flow, table)
+        rx = v[0, i] - ux
+        ry = v[1, i] - uy
+        rz = v[2, i] - uz if dim == 3 else 0.0
+        fx = fy = fz = 0.0
+        if quadratic or linear:
+            qx, qy, qz = node_tangent(x, i, closed)
+            along = rx * qx + ry * qy + rz * qz
+            tx, ty, tz = along * qx, along * qy, along * qz
+            nx, ny, nz = rx - tx, ry - ty, rz - tz
+            length = p.node_length[i]
+            if quadratic:
+                cn = c_n * length * math.sqrt(nx * nx + ny * ny + nz * nz)
+                ct = c_t * length * abs(along)
+                fx -= cn * nx + ct * tx
+                fy -= cn * ny + ct * ty
+                fz -= cn * nz + ct * tz
+            if linear:
+                fx -= length * (b_n * nx + b_t * tx)
+                fy -= length * (b_n * ny + b_t * ty)
+                fz -= length * (b_n * nz + b_t * tz)
+        if body and p.body_drag[i] > 0.0:
+            cb = p.body_drag[i] * math.sqrt(rx * rx + ry * ry + rz * rz)
+            fx -= cb * rx
+            fy -= cb * ry
+            fz -= cb * rz
+        inv_m = p.inv_mass[i]
+        if push:   # + b U, as an acceleration (b / m) U
+            fx += p.flow_push[i] * ux / inv_m
+            fy += p.flow_push[i] * uy / inv_m
+            fz += p.flow_push[i] * uz / inv_m
+        acc[0, i] += fx * inv_m
+        acc[1, i] += fy * inv_m
+        power += fx * v[0, i] + fy * v[1, i]
+        if dim == 3:
+            acc[2, i] += fz * inv_m
+            power += fz * v[2, i]
+    return power
+
+
+
+@njit(cache=True, error_model="numpy")
+def add_fluid_jacobian(x, v, band, beta, free, p, t):
+    """Add beta C to the Newton matrix's node blocks (see :mod:`ropesim.model.jacobian`), C = -dF/dv the fluid
+    forces' damping at the current state, with the tangent frozen (its dependence on positions is left out):
+
+    quadratic c_n L (|u_n| P + |u_n| n n^T) + 2 c_t L |u . q| q q^T (P = I - q q^T, n = u_n / |u_n|); linear
+    L (b_n P + b_t q q^T); a body c_b (|u| I + |u| r r^T) (r = u / |u|). All positive semi-definite.
+    """
+    dim, n = x.shape
+    closed = p.spring[2] != 0.0
+    flags = p.flags
+    quadratic, linear, body, moving = (flags[FLUID_DRAG] != 0, flags[VISCOUS_DRAG] != 0, flags[BODY_DRAG] != 0,
+                                       flags[FLOW] != 0)
+    flow, table = p.flow
+    blk = np.zeros((3, 3))
+    for i in range(n):
+        if not free[i]:
+            continue
+        ux = uy = uz = 0.0
+        if moving:
+            ux, uy, uz = flow_at(x[1, i], t, flow, table)
+        r = (v[0, i] - ux, v[1, i] - uy, v[2, i] - uz if dim == 3 else 0.0)
+        blk[:] = 0.0
+        if quadratic or linear:
+            q = node_tangent(x, i, closed)
+            along = r[0] * q[0] + r[1] * q[1] + r[2] * q[2]
+            nv = (r[0] - along * q[0], r[1] - along * q[1], r[2] - along * q[2])
+            speed_n = math.sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2])
+            length = p.node_length[i]
+            for a in range(3):
+                for b in range(3):
+                    proj = (1.0 if a == b else 0.0) - q[a] * q[b]
+                    qq = q[a] * q[b]
+                    if quadratic:
+                        blk[a, b] += p.fluid_drag[0] * length * speed_n * proj
+                        if speed_n > 0.0:
+                            blk[a, b] += p.fluid_drag[0] * length * nv[a] * nv[b] / speed_n
+                        blk[a, b] += 2.0 * p.fluid_drag[1] * length * abs(along) * qq
+                    if linear:
+                        blk[a, b] += length * (p.viscous_drag[0] * proj + p.viscous_drag[1] * qq)
+        if body and p.body_drag[i] > 0.0:
+            speed = math.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
+            if speed > 0.0:
+                for a in range(3):
+                    for b in range(3):
+                        blk[a, b] += p.body_drag[i] * (speed * (1.0 if a == b else 0.0) + r[a] * r[b] / speed)
+        for a in range(dim):
+            for b in range(a + 1):
+                band[a - b, i * dim + b] += beta * blk[a, b]
+
+
+def speed_scale(model) -> float:
+    """A speed [m/s] the run's relative velocities stay near: twice the largest of the initial and held node
+    speeds, the flow's largest speed and the thrower's v_max (for the stability bound of velocity-dependent
+    drag, which grows with speed)."""
+    scene = model.scene
+    speeds = [float(np.abs(model.v0).max(initial=0.0)), float(np.abs(model.held_v).max(initial=0.0))]
+    if scene.flow is not None:
+        rows = [scene.flow.velocity] if scene.flow.velocity is not None else list(scene.flow.velocities)
+        speeds.append(max(math.hypot(*row) for row in rows))
+    if scene.thrower is not None:
+        speeds.append(abs(scene.thrower.v_max))
+    return 2.0 * max(speeds + [1.0])
+
+
+def _free_min_mass(model) -> float:
+    free = ~model.held
+    return float(model.mass[free].min()) if free.any() else float(model.mass.min())
+
+
+def _quadratic_rate(model) -> float:
+    """Largest d(drag force)/d(speed) / mass [1/s] of the quadratic drag at the speed scale: 2 c L U / m."""
+    p, free = model.params, ~model.held
+    c = max(p.fluid_drag[0], p.fluid_drag[1])
+    return float(np.max(2.0 * c * p.node_length[free] * speed_scale(model) / model.mass[free], initial=0.0))
+
+
+def _fluid_drag(scene, layout) -> np.ndarray:
+    rho, d = scene.fluid.density, scene.rope.diameter
+    return np.array([0.5 * rho * scene.fluid_drag.cd_normal * d, 0.5 * rho * scene.fluid_drag.cd_tangential * math.pi * d])
+
+
+def _body_drag(scene, layout) -> np.ndarray:
+    out = np.zeros(len(layout.mass))
+    for body in scene.bodies:
+        out[scene.node(body.node)] = 0.5 * scene.fluid.density * body.cd_area if body.cd_area > 0 else 0.0
+    return out
+
+
+def _flow(scene, layout) -> tuple:
+    f = scene.flow
+    scalars = np.zeros(FLOW_PARAMS)
+    scalars[0], scalars[1], scalars[2] = PROFILES[f.profile], f.ramp_time, f.datum
+    if f.profile == "power_law":
+        scalars[3], scalars[4] = f.reference_height, f.exponent
+    if f.velocity is not None:
+        scalars[5:5 + len(f.velocity)] = f.velocity
+    table = np.zeros((0, 4))
+    if f.profile == "table":
+        table = np.zeros((len(f.heights), 4))
+        table[:, 0] = f.heights
+        table[:, 1:1 + scene.dimension] = np.asarray(f.velocities)
+    return scalars, table
+
+
+def _flow_push(scene, layout) -> np.ndarray:
+    b = np.full(len(layout.mass), scene.drag.b)
+    for o in scene.overrides:
+        if o.drag is not None:
+            b[scene.node(o.index)] = o.drag
+    return np.where(layout.held, 0.0, b / layout.mass)
+
+
+FLUID_DRAG_TERM = Term("fluid_drag", FLUID_DRAG, _fluid_drag, lambda: np.zeros(2), damping=_quadratic_rate,
+                       ledger="fluid", velocity=True)
+VISCOUS_DRAG_TERM = Term(
+    "viscous_drag", VISCOUS_DRAG, lambda scene, layout: np.array([scene.viscous_drag.b_normal,
+                                                                  scene.viscous_drag.b_tangential]),
+    lambda: np.zeros(2), ledger="fluid", velocity=True,
+    damping=lambda model: float(np.max(max(model.params.viscous_drag) * model.params.node_length[~model.held]
+                                       / model.mass[~model.held], initial=0.0)))
+BODY_DRAG_TERM = Term(
+    "bodies", BODY_DRAG, _body_drag, lambda: np.zeros(0), ledger="fluid", velocity=True,
+    active=lambda scene: any(b.cd_area > 0 for b in scene.bodies),
+    damping=lambda model: float(np.max(2.0 * model.params.body_drag * speed_scale(model) / model.mass,
+                                       initial=0.0)))
+FLOW_TERM = Term("flow", FLOW, _flow, lambda: (np.zeros(FLOW_PARAMS), np.zeros((0, 4))))
+"""The flow field itself: no force of its own (the drag terms act on the velocity relative to it)."""
+FLOW_PUSH_TERM = Term("drag", FLOW_PUSH, _flow_push, lambda: np.zeros(0), ledger="fluid", velocity=True,
+                      active=lambda scene: scene.flow is not None and scene.drag is not None)
+"""The flow's push on the linear [drag]: + b U per node."""
