@@ -188,8 +188,8 @@ def union_shapes(name: str) -> dict:
     schema = _schema()
     if name == "initial":
         return dict(schema.INITIAL_SHAPES)
-    raise KeyError(f"scene table [{name}] is a tagged union that docs/hooks/reference.py does not know; "
-                   f"teach union_shapes() where its variants are listed")
+    raise ValueError(f"scene table [{name}] is a tagged union that docs/hooks/reference.py does not know; "
+                     f"teach union_shapes() where its variants are listed")
 
 
 def _union_section(name: str, status: str) -> str:
@@ -205,21 +205,6 @@ def _union_section(name: str, status: str) -> str:
                    + key_table([(f"{name}-{shape}.{f.name}", f.name, f.metadata["spec"],
                                  default_of(f"{name}.{f.name}", f)) for f in spec_fields(cls)]))
     return "\n\n".join(out)
-
-
-def scene_keys() -> dict[str, list[tuple[str, object]]]:
-    """Every key of the schema, by the section that documents it: {section: [(key, spec), ...]}.
-
-    The docs tests walk this independently of the Markdown, from the schema's own lists."""
-    schema = _schema()
-    out = {"top-level": list(schema.TOP_LEVEL_SCALARS.items())}
-    for name, cls in {**schema.TABLES, **schema.ARRAYS_OF_TABLES}.items():
-        if cls is None:
-            out[name] = [(f.name, f.metadata["spec"]) for shape in union_shapes(name).values()
-                         for f in spec_fields(shape)]
-        else:
-            out[name] = [(f.name, f.metadata["spec"]) for f in spec_fields(cls)]
-    return out
 
 
 # ---------------------------------------------------------------------------------------- command line
@@ -348,18 +333,6 @@ def cli_summary_table() -> str:
     return "\n".join(rows)
 
 
-def cli_options() -> dict[str, list[list[str]]]:
-    """{command: [[spellings of one option], ...]}, for the tests, straight from the app."""
-    out = {}
-    group, ctx = cli_root()
-    out["ropesim"] = [param_names(p) for p in _params(group, ctx)[1]]
-    for name in cli_commands():
-        command, cctx = _command(name)
-        arguments, options = _params(command, cctx)
-        out[name] = [param_names(p) for p in arguments + options]
-    return out
-
-
 # ------------------------------------------------------------------------------------------ Python API
 
 
@@ -414,6 +387,9 @@ def expand(markdown: str, where: str = "page") -> str:
         except KeyError:
             what = {"scene": "scene table", "cli": "command", "api": "public name in ropesim.__all__"}[kind]
             log.warning("%s: <!-- ropesim:%s %s -->: no such %s in the code", where, kind, name, what)
+            return ""
+        except ValueError as exc:
+            log.warning("%s: <!-- ropesim:%s %s -->: %s", where, kind, name, exc)
             return ""
 
     return MARKER.sub(generate, markdown)
