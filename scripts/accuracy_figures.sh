@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the README's "Accuracy and stability" figures and tables (a few minutes on 2 cores):
+# Regenerate the figures and tables of the docs' "Accuracy and stability" page (a few minutes on 2 cores):
 #   docs/images/accuracy_helicopter.png   work-precision, smooth towed rope (orders 1, 2, 4, 4, 4, 2)
 #   docs/images/accuracy_stiff.png        work-precision, k = 1e8 N/m over 10 s: where the stiff integrator wins
 #   docs/images/stability_helicopter.png  stable/unstable map against the predicted bounds, k = 5e3 .. 5e7

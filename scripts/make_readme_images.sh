@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate the README's pictures of the built-in scenarios (docs/images/scenarios/) with ropesim's own
+# Regenerate the docs' pictures of the built-in scenarios (docs/images/scenarios/) with ropesim's own
 # commands: the towed ropes as overlaid frames seen from the helicopter, run long enough to reach their steady
 # shapes (plus the plot of the one with the end mass), the string shooters as small GIFs of their default runs.
 #

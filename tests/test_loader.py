@@ -1,14 +1,13 @@
 """The strict scene loader: what it accepts, how it refuses, --set overrides, the resolved-scene round trip,
-property-based attacks on it, and the README's schema reference kept in step with the schema."""
+and property-based attacks on it. (The scene reference's agreement with the schema: tests/test_docs.py.)"""
 
 from __future__ import annotations
 
 import copy
 import math
-import re
 import tomllib
 import warnings
-from dataclasses import MISSING, fields, replace
+from dataclasses import fields, replace
 
 import numpy as np
 import pytest
@@ -25,7 +24,7 @@ from ropesim.integrate.grid import TimeGrid
 from ropesim.integrate.methods import make_integrator
 from ropesim.run import BLEW_UP, COMPLETED, simulate
 
-from conftest import ROOT, SCENARIOS
+from conftest import SCENARIOS
 
 SOURCE = "t.toml"
 SCENARIO_FILES = sorted(SCENARIOS.glob("*.toml"))
@@ -689,83 +688,3 @@ toml_lines = st.one_of(
 @given(st.lists(toml_lines, max_size=12))
 def test_random_toml_ish_text_never_crashes(lines):
     _accepted_or_one_line("\n".join(lines))
-
-
-# -------------------------------------------------------------------------------- the README schema
-
-
-def _readme_section() -> str:
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
-    match = re.search(r"^## Scene files\n(.*?)(?=^## |\Z)", text, flags=re.M | re.S)
-    assert match, "README.md has no '## Scene files' section"
-    return match.group(1)
-
-
-def _subsections(section: str) -> dict[str, str]:
-    """The '### ...' subsections of the README section by heading."""
-    parts = re.split(r"^### (.*)$", section, flags=re.M)
-    return {parts[i].strip(): parts[i + 1] for i in range(1, len(parts), 2)}
-
-
-def _rows(body: str) -> dict[str, str]:
-    """Reference-table rows keyed by their first cell's `key`."""
-    return {m.group(1): m.group(0) for m in re.finditer(r"^\| `([a-z_0-9]+)` \|.*$", body, flags=re.M)}
-
-
-def _schema() -> dict[str, list[tuple[str, S.Spec, object]]]:
-    """Every key of the schema as (name, spec, default or None), by the README heading that documents it."""
-    def keys(cls):
-        return [(f.name, f.metadata["spec"], None if f.default is MISSING else f.default)
-                for f in fields(cls) if "spec" in f.metadata]
-
-    out = {"top-level keys": [(name, sp, None) for name, sp in S.TOP_LEVEL_SCALARS.items()]}
-    tables = {**{k: v for k, v in S.TABLES.items() if v is not None}, **S.ARRAYS_OF_TABLES}
-    for key, cls in tables.items():
-        out[f"[[{key}]]" if key in S.ARRAYS_OF_TABLES else f"[{key}]"] = keys(cls)
-    out["[initial]"] = [("shape", S.Spec("str", "", choices=tuple(S.INITIAL_SHAPES)), None)] + [
-        item for cls in S.INITIAL_SHAPES.values() for item in keys(cls)]
-    return out
-
-
-def _shown(default) -> str:
-    if isinstance(default, bool):
-        return str(default).lower()
-    return f"{default:g}" if isinstance(default, float) else str(default)
-
-
-def test_readme_documents_every_key_of_the_schema():
-    """Each table has a '### `[table]`' subsection with a row per key giving its unit, choices and default."""
-    subsections = _subsections(_readme_section())
-    for heading, keys in _schema().items():
-        matching = [body for title, body in subsections.items() if heading.lower() in title.lower()]
-        assert matching, f"README 'Scene files' has no '### ...{heading}...' subsection"
-        rows = _rows(matching[0])
-        for name, sp, default in keys:
-            assert name in rows, f"README {heading}: no row for `{name}`"
-            cells = [c.strip() for c in re.split(r"(?<!\\)\|", rows[name].strip())[1:-1]]  # \| is no border
-            assert len(cells) == 5, f"README {heading} `{name}`: expected key | type | unit | default | meaning"
-            _, kind, unit, shown_default, meaning = cells
-            assert unit == sp.unit, f"README {heading} `{name}`: unit {unit!r}, the schema says {sp.unit!r}"
-            for choice in sp.choices:
-                assert str(choice) in kind, f"README {heading} `{name}`: choice {choice} missing"
-            if sp.required and heading != "[initial]":
-                assert shown_default == "required", f"README {heading} `{name}` is required"
-            if default is not None:
-                assert _shown(default) in shown_default, f"README {heading} `{name}`: default {default}"
-            assert meaning, f"README {heading} `{name}`: no meaning"
-        assert set(rows) <= {name for name, _, _ in keys}, f"README {heading} documents unknown keys"
-
-
-def test_readme_examples_are_valid_scenes():
-    """Each ```toml block of the section is a complete scene, or a fragment that loads on top of a base one."""
-    blocks = re.findall(r"```toml\n(.*?)```", _readme_section(), flags=re.S)
-    assert len(blocks) >= 10
-    base = copy.deepcopy(LINE)
-    base["rope"]["nodes"] = 21
-    for block in blocks:
-        fragment = tomllib.loads(block)
-        raw = fragment if "rope" in fragment and "integrator" in fragment else {**base, **fragment}
-        try:
-            load(raw, source="README")
-        except SceneError as exc:
-            pytest.fail(f"README example does not load: {exc}\n{block}")

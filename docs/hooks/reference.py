@@ -1,0 +1,401 @@
+"""MkDocs hook: the scene-file and command-line references, generated from the code at every build.
+
+A page asks for a generated part with an HTML comment on a line of its own:
+
+    <!-- ropesim:scene rope -->     the [rope] table: heading, the dataclass's docstring, one row per key
+    <!-- ropesim:scene rest -->     every table not placed earlier on the page, in the schema's order
+    <!-- ropesim:cli run -->        the `ropesim run` command: summary, usage, arguments, options
+    <!-- ropesim:cli rest -->       every command not placed earlier on the page, in the app's order
+
+So a key, a table or a command added to the code appears in the docs without anyone editing a page, and a
+marker naming something the code no longer has is a warning (an error under ``mkdocs build --strict``).
+The scene reference reads ``ropesim.scene.schema`` (each field's ``metadata["spec"]``: kind, unit, range,
+choices, doc; the field's default; the table's docstring); the CLI reference reads the Typer app through
+``typer.main.get_command`` and the click parameters' own help records. ``tests/test_docs.py`` tests both
+generators against the schema and the app, and the built pages.
+"""
+
+from __future__ import annotations
+
+import inspect
+import logging
+import re
+from dataclasses import MISSING, fields
+
+log = logging.getLogger("mkdocs.hooks.ropesim")
+
+MARKER = re.compile(r"^<!-- ropesim:(scene|cli|api) ([A-Za-z0-9_.-]+) -->[ \t]*$", re.M)
+
+# ------------------------------------------------------------------------------------------ scene file
+
+KINDS = {
+    "int": "integer",
+    "float": "number",
+    "bool": "boolean",
+    "str": "string",
+    "vector": "vector",
+    "int_list": "node indices",
+    "points": "list of vectors",
+}
+
+# What a key left out means when the schema's default is None ("work it out from the rest of the scene").
+# Keyed by dotted path (table.key; the initial shapes share "initial."). tests/test_docs.py checks that
+# every entry still names a key of the schema, so this list cannot outlive the keys it describes.
+WHEN_ABSENT = {
+    "name": "the file's stem",
+    "description": '`""`',
+    "dimension": "`2`",
+    "initial.top": "the origin",
+    "initial.top_center": "the thrower's `center`",
+    "initial.velocity": "zero",
+    "overrides.mass": "the rope's `mass`",
+    "overrides.drag": "the `[drag]` table's `b` (0 without one)",
+    "thrower.omega0": "4π |v_max| / L",
+    "guides.omega0": "the thrower's ω0 (required without a `[thrower]`)",
+}
+
+
+def _schema():
+    from ropesim.scene import schema
+
+    return schema
+
+
+def _number(value) -> str:
+    if isinstance(value, float) and value.is_integer() and abs(value) < 1e15:
+        value = int(value)
+    if isinstance(value, int) and abs(value) >= 10_000:
+        return f"{value:,}".replace(",", "\u202f")  # narrow no-break space: 1 000 000
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def _toml(value) -> str:
+    """A default as it is written in a scene file."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, (tuple, list)):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    return str(value)
+
+
+def allowed(spec) -> str:
+    """The values a key accepts, as shown in the reference's 'allowed' column."""
+    if spec.choices:
+        return "one of " + ", ".join(f"`{_toml(c)}`" for c in spec.choices)
+    if spec.low is not None and spec.high is not None:
+        return f"{_number(spec.low)} to {_number(spec.high)}" if not spec.open_low else \
+            f"> {_number(spec.low)}, ≤ {_number(spec.high)}"
+    if spec.low is not None:
+        return f"{'>' if spec.open_low else '≥'} {_number(spec.low)}"
+    if spec.high is not None:
+        return f"≤ {_number(spec.high)}"
+    return {
+        "bool": "`true` or `false`",
+        "vector": "`dimension` numbers",
+        "int_list": "a list of indices, or one; −N to N−1",
+        "points": "N vectors",
+        "str": "any",
+        "int": "any integer",
+        "float": "any number",
+    }.get(spec.kind, "any")
+
+
+def _text(doc: str) -> str:
+    """A docstring or spec doc as Markdown: reST ``code`` becomes `code`; a table cell's | is escaped."""
+    return re.sub(r"``([^`]+)``", r"`\1`", doc)
+
+
+def _cell(text: str) -> str:
+    return _escape_html(text).replace("|", "\\|").replace("\n", " ")
+
+
+def _escape_html(text: str) -> str:
+    """Escape < and > outside `code` spans, so that e.g. runs/<scene name>/ is not taken for an HTML tag."""
+    parts = re.split(r"(`[^`]*`)", text)
+    return "".join(p if p.startswith("`") else p.replace("<", "&lt;").replace(">", "&gt;") for p in parts)
+
+
+def _docstring(cls) -> str:
+    return _text(inspect.cleandoc(cls.__doc__ or ""))
+
+
+def spec_fields(cls) -> list:
+    """The keys of one table: its dataclass fields that carry a Spec (an initial shape's `shape` tag does not)."""
+    return [f for f in fields(cls) if "spec" in f.metadata]
+
+
+def default_of(path: str, f) -> str:
+    """The 'default' column: **required**, the TOML literal, or what leaving it out means."""
+    spec = f.metadata["spec"]
+    if f.default is MISSING and f.default_factory is MISSING:
+        return "**required**"
+    if f.default is not None:
+        return f"`{_toml(f.default)}`"
+    return WHEN_ABSENT.get(path, "none" if not spec.required else "**required**")
+
+
+def key_table(rows: list[tuple[str, str, object, str]]) -> str:
+    """rows: (anchor id, key, spec, default column)."""
+    out = ["| key | type | unit | allowed | default | meaning |", "|---|---|---|---|---|---|"]
+    for anchor, key, spec, default in rows:
+        kind = KINDS.get(spec.kind, spec.kind)
+        unit = spec.unit.replace("^2", "²") if spec.unit else ""
+        out.append(f"| <a id=\"{anchor}\"></a>`{key}` | {kind} | {unit} | {_cell(allowed(spec))} | "
+                   f"{_cell(default)} | {_cell(_text(spec.doc))} |")
+    return "\n".join(out)
+
+
+def _table_rows(prefix: str, cls) -> list:
+    return [(f"{prefix}.{f.name}", f.name, f.metadata["spec"], default_of(f"{prefix}.{f.name}", f))
+            for f in spec_fields(cls)]
+
+
+def scene_tables() -> list[str]:
+    """Every part of a scene file the reference documents, in the order a resolved scene.toml lists them."""
+    schema = _schema()
+    return ["top-level", *schema.TABLES, *schema.ARRAYS_OF_TABLES]
+
+
+def scene_section(name: str) -> str:
+    """The generated Markdown for one part of a scene file (see :func:`scene_tables`)."""
+    schema = _schema()
+    required = set(getattr(schema, "REQUIRED_TABLES", ()))
+    if name == "top-level":
+        rows = [(key, key, spec, WHEN_ABSENT.get(key, "**required**" if spec.required else "none"))
+                for key, spec in schema.TOP_LEVEL_SCALARS.items()]
+        return "## Top-level keys {#top-level}\n\nKeys before the first table.\n\n" + key_table(rows)
+    if name in schema.ARRAYS_OF_TABLES:
+        cls = schema.ARRAYS_OF_TABLES[name]
+        return (f"## `[[{name}]]` {{#{name}}}\n\n{_docstring(cls)}\n\n"
+                f"An array of tables: write one `[[{name}]]` header per entry. `--set` addresses entry i as "
+                f"`{name}.i.KEY`, counting from 0.\n\n" + key_table(_table_rows(name, cls)))
+    if name not in schema.TABLES:
+        raise KeyError(name)
+    cls = schema.TABLES[name]
+    status = "**Required.**" if name in required else \
+        "Optional: a scene without this table does without this part of the model."
+    if cls is None:
+        return _union_section(name, status)
+    return f"## `[{name}]` {{#{name}}}\n\n{status} {_docstring(cls)}\n\n" + key_table(_table_rows(name, cls))
+
+
+def union_shapes(name: str) -> dict:
+    """A tagged-union table (TABLES[name] is None): its tag's values and their dataclasses."""
+    schema = _schema()
+    if name == "initial":
+        return dict(schema.INITIAL_SHAPES)
+    raise ValueError(f"scene table [{name}] is a tagged union that docs/hooks/reference.py does not know; "
+                     f"teach union_shapes() where its variants are listed")
+
+
+def _union_section(name: str, status: str) -> str:
+    from ropesim.scene.schema import Spec
+
+    shapes = union_shapes(name)
+    tag = Spec("str", "which layout; each has its own keys below, and a key of another one is refused",
+               choices=tuple(shapes))
+    out = [f"## `[{name}]` {{#{name}}}\n\n{status} The key `shape` chooses one of {len(shapes)} layouts, each "
+           f"with its own keys.\n\n" + key_table([(f"{name}.shape", "shape", tag, "**required**")])]
+    for shape, cls in shapes.items():
+        out.append(f"### `shape = \"{shape}\"` {{#{name}-{shape}}}\n\n{_docstring(cls)}\n\n"
+                   + key_table([(f"{name}-{shape}.{f.name}", f.name, f.metadata["spec"],
+                                 default_of(f"{name}.{f.name}", f)) for f in spec_fields(cls)]))
+    return "\n\n".join(out)
+
+
+# ---------------------------------------------------------------------------------------- command line
+
+
+def cli_root():
+    """The Typer app as a click-style group, and its context (help option names and all)."""
+    import typer
+
+    from ropesim.cli.app import app
+
+    group = typer.main.get_command(app)
+    ctx = typer.Context(group, info_name="ropesim", **(group.context_settings or {}))
+    return group, ctx
+
+
+def cli_commands() -> list[str]:
+    group, ctx = cli_root()
+    return [name for name in group.list_commands(ctx) if not group.get_command(ctx, name).hidden]
+
+
+def _command(name: str):
+    import typer
+
+    group, ctx = cli_root()
+    command = group.get_command(ctx, name)
+    if command is None:
+        raise KeyError(name)
+    return command, typer.Context(command, info_name=name, parent=ctx)
+
+
+def _params(command, ctx) -> tuple[list, list]:
+    params = [p for p in command.get_params(ctx) if not getattr(p, "hidden", False)]
+    arguments = [p for p in params if not p.opts or not p.opts[0].startswith("-")]
+    options = [p for p in params if p not in arguments]
+    return arguments, options
+
+
+def param_names(param) -> list[str]:
+    """Every spelling of an option (--out, -o), or an argument's name in capitals."""
+    names = list(param.opts) + list(getattr(param, "secondary_opts", []))
+    if names and names[0].startswith("-"):
+        return names
+    return [param.name.upper()]
+
+
+def _split_record(help_text: str) -> tuple[str, str]:
+    """click puts '[default: 25.0; x>=1]' and '[required]' at the end of a help record: split them off."""
+    extras = []
+    while True:
+        match = re.search(r"\s*\[([^\[\]]*)\]\s*$", help_text)
+        if not match or not re.match(r"(default|required|env var|x[<>]|\d)", match.group(1)):
+            break
+        extras.insert(0, match.group(1))
+        help_text = help_text[: match.start()]
+    return help_text.strip(), "; ".join(extras)
+
+
+def _usage(name: str, command, ctx) -> str:
+    arguments, _ = _params(command, ctx)
+    words = ["ropesim", name, "[OPTIONS]"] + [
+        f"{p.name.upper()}{'...' if getattr(p, 'nargs', 1) == -1 else ''}" if p.required else f"[{p.name.upper()}]"
+        for p in arguments]
+    return " ".join(words)
+
+
+def _options_table(options, ctx) -> str:
+    out = ["| option | meaning | default |", "|---|---|---|"]
+    for p in options:
+        names, help_text = p.get_help_record(ctx)
+        help_text, extra = _split_record(help_text or "")
+        if getattr(p, "multiple", False) and "repeatable" not in help_text:
+            help_text += " Repeatable."
+        anchor = max(p.opts, key=len).lstrip("-") if p.opts else p.name
+        default, notes = "", []
+        for part in filter(None, (x.strip() for x in extra.split(";"))):
+            if part.startswith("default:"):
+                default = f"`{part[len('default:'):].strip()}`"
+            else:
+                notes.append(part)
+        if notes:
+            help_text += f" ({'; '.join(notes)})"
+        out.append(f"| <a id=\"{ctx.info_name}-{anchor}\"></a>`{names}` | {_cell(help_text)} | {_cell(default)} |")
+    return "\n".join(out)
+
+
+def _paragraphs(text: str) -> str:
+    """A command's help as Markdown: paragraphs as they are, an indented paragraph as a code block."""
+    out = []
+    for para in inspect.cleandoc(text or "").split("\n\n"):
+        lines = para.split("\n")
+        if all(line.startswith("  ") for line in lines):
+            out.append("```text\n" + "\n".join(line[2:] for line in lines) + "\n```")
+        else:
+            out.append(_escape_html(para))
+    return "\n\n".join(out)
+
+
+def cli_section(name: str) -> str:
+    """The generated Markdown for one command: summary, usage, arguments and options."""
+    if name == "ropesim":
+        group, ctx = cli_root()
+        _, options = _params(group, ctx)
+        return (f"## `ropesim` {{#ropesim}}\n\n{_paragraphs(group.help)}\n\n```text\nropesim [OPTIONS] COMMAND "
+                f"[ARGS]...\n```\n\n" + _options_table(options, ctx))
+    command, ctx = _command(name)
+    arguments, options = _params(command, ctx)
+    out = [f"## `ropesim {name}` {{#{name}}}", _paragraphs(command.help), f"```text\n{_usage(name, command, ctx)}\n```"]
+    if arguments:
+        rows = ["| argument | meaning |", "|---|---|"]
+        for p in arguments:
+            help_text, _ = _split_record((p.get_help_record(ctx) or ("", ""))[1] or getattr(p, "help", "") or "")
+            rows.append(f"| `{param_names(p)[0]}` | {_cell(help_text)} |")
+        out.append("\n".join(rows))
+    out.append(_options_table(options, ctx))
+    return "\n\n".join(out)
+
+
+def cli_summary_table() -> str:
+    """One row per command: its name (linked to its section) and the first line of its help."""
+    rows = ["| command | what it does |", "|---|---|"]
+    for name in cli_commands():
+        command, _ = _command(name)
+        first = inspect.cleandoc(command.help or "").split("\n\n")[0].replace("\n", " ")
+        rows.append(f"| [`ropesim {name}`](#{name}) | {_cell(first)} |")
+    return "\n".join(rows)
+
+
+# ------------------------------------------------------------------------------------------ Python API
+
+
+def api_names() -> list[str]:
+    """The public API: ``ropesim.__all__``."""
+    import ropesim
+
+    return list(ropesim.__all__)
+
+
+def api_path(name: str) -> str:
+    """Where a public name is defined, for mkdocstrings: ``ropesim.run.simulate`` for ``simulate``.
+
+    ``ropesim`` exports its names lazily (``__getattr__``), which static analysis cannot follow, so each is
+    documented where it lives; looked up at every build, the page follows the code when a module moves."""
+    import ropesim
+
+    if name not in ropesim.__all__:
+        raise KeyError(name)
+    obj = getattr(ropesim, name)
+    module = getattr(obj, "__module__", None) if isinstance(obj, type) or callable(obj) else None
+    if module is None:
+        module = f"ropesim.{ropesim._LAZY[name]}"
+    return f"{module}.{name}"
+
+
+def api_section(name: str) -> str:
+    return f"::: {api_path(name)}\n    options:\n      heading: \"ropesim.{name}\"\n      toc_label: \"{name}\""
+
+
+# ---------------------------------------------------------------------------------------------- hook
+
+
+def expand(markdown: str, where: str = "page") -> str:
+    """Replace every ropesim marker of a page by its generated Markdown."""
+    placed = {"scene": set(), "cli": set(), "api": set()}
+    for kind, name in MARKER.findall(markdown):
+        placed[kind].add(name)
+
+    def generate(match: re.Match) -> str:
+        kind, name = match.group(1), match.group(2)
+        if name == "rest":
+            names = {"scene": scene_tables, "cli": cli_commands, "api": api_names}[kind]()
+            return "\n\n".join(generate_one(kind, n) for n in names if n not in placed[kind])
+        if kind == "cli" and name == "summary":
+            return cli_summary_table()
+        return generate_one(kind, name)
+
+    def generate_one(kind: str, name: str) -> str:
+        try:
+            return {"scene": scene_section, "cli": cli_section, "api": api_section}[kind](name)
+        except KeyError:
+            what = {"scene": "scene table", "cli": "command", "api": "public name in ropesim.__all__"}[kind]
+            log.warning("%s: <!-- ropesim:%s %s -->: no such %s in the code", where, kind, name, what)
+            return ""
+        except ValueError as exc:
+            log.warning("%s: <!-- ropesim:%s %s -->: %s", where, kind, name, exc)
+            return ""
+
+    return MARKER.sub(generate, markdown)
+
+
+def on_page_markdown(markdown: str, page, config, files, **kwargs) -> str:
+    if "<!-- ropesim:" not in markdown:
+        return markdown
+    return expand(markdown, page.file.src_uri)
