@@ -7,27 +7,59 @@ they computed.
 
 from __future__ import annotations
 
+import inspect
 import sys
 from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
+from typer.core import TyperCommand, TyperGroup
+
+from .. import __version__
+
+
+class _CleanHelp:
+    """Help as a person reads it: no type shown for a flag (typer 0.29 labels every flag <bool>, as if it took
+    a value: `--help -h <bool>`), and a docstring's paragraphs wrapped to the terminal rather than broken where
+    the source lines end."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        if self.help:
+            self.help = "\n\n".join(" ".join(p.split()) for p in inspect.cleandoc(self.help).split("\n\n"))
+
+    def get_params(self, ctx):
+        params = super().get_params(ctx)
+        for param in params:
+            if getattr(param, "is_flag", False) and param.metavar is None:
+                param.metavar = ""
+        return params
+
+
+class Command(_CleanHelp, TyperCommand):
+    pass
+
+
+class Group(_CleanHelp, TyperGroup):
+    pass
+
 
 app = typer.Typer(
     name="ropesim",
+    cls=Group,
     help="Simulate ropes: point masses joined by stiff springs, under gravity and air drag.\n\n"
-         "Scenes are TOML files (see scenarios/ and the README). Start with:\n\n"
-         "  ropesim run scenarios/helicopter_mass.toml",
+         "A scene is a TOML file or the name of a built-in scene (`ropesim scenarios` lists them). Start with:\n\n"
+         "  ropesim run helicopter_mass",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
     context_settings={"help_option_names": ["-h", "--help"]},
 )
-
 EXIT_BAD_INPUT, EXIT_BLEW_UP, EXIT_INTERRUPTED = 2, 3, 130
 
-SceneArg = Annotated[Path, typer.Argument(help="Scene file (TOML), e.g. scenarios/helicopter_mass.toml.",
-                                          show_default=False)]
+SceneArg = Annotated[str, typer.Argument(
+    metavar="SCENE", help="A scene file (TOML), or the name of a built-in scene such as helicopter_mass "
+                          "(`ropesim scenarios` lists them).", show_default=False)]
 SetOpt = Annotated[Optional[list[str]], typer.Option(
     "--set", "-s", metavar="KEY=VALUE",
     help="Override a scene key by its dotted TOML path, typed and validated like the file; repeatable. "
@@ -40,16 +72,47 @@ def fail(message: str, code: int = EXIT_BAD_INPUT) -> None:
     raise typer.Exit(code)
 
 
-def _load(scene_file: Path, sets: list[str] | None):
-    from ..scene.loader import SceneError, load_scene
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(f"ropesim {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(
+    version: Annotated[bool, typer.Option("--version", "-V", callback=_version, is_eager=True,
+                                          help="Print ropesim's version and exit.")] = False,
+) -> None:
+    pass  # the app's options only (its help is the Typer's help above)
+
+
+def _source(scene: str):
+    """The scene file a SCENE argument means (a path, or a built-in's name); one line and exit 2 if none."""
+    from ..scene.builtin import resolve
+    from ..scene.loader import SceneError
 
     try:
-        return load_scene(scene_file, sets or [])
+        return resolve(scene)
     except SceneError as exc:
         fail(str(exc))
 
 
-@app.command()
+def _load(scene: str, sets: list[str] | None):
+    """The scene a SCENE argument means, validated, with ``--set`` applied, and how to name it in messages."""
+    from ..scene.loader import SceneError, load_scene, scene_from_toml
+
+    source = _source(scene)
+    try:
+        if source.builtin:
+            text = source.path.read_text(encoding="utf-8")
+            return scene_from_toml(text, source=source.label, default_name=source.path.stem,
+                                   overrides=sets or []), source.label
+        return load_scene(source.path, sets or []), source.label
+    except SceneError as exc:
+        fail(str(exc))
+
+
+@app.command(cls=Command)
 def run(
     scene_file: SceneArg,
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Run folder (default runs/<scene name>/).",
@@ -66,8 +129,8 @@ def run(
     from .report import print_summary
     from ..run import BLEW_UP, INTERRUPTED, simulate
 
-    scene = _load(scene_file, sets)
-    _check_time_step(scene, scene_file, force, quiet)
+    scene, where = _load(scene_file, sets)
+    _check_time_step(scene, where, force, quiet)
     folder = out if out is not None else Path("runs") / scene.name
     if folder.exists() and not folder.is_dir():
         fail(f"--out {folder}: exists and is not a folder")
@@ -79,14 +142,14 @@ def run(
     if not quiet:
         print_summary(summary, folder)
     if summary["status"] == BLEW_UP:
-        fail(f"{scene_file}: {summary['message']}; frames up to then are in {folder}", EXIT_BLEW_UP)
+        fail(f"{where}: {summary['message']}; frames up to then are in {folder}", EXIT_BLEW_UP)
     if summary["status"] == INTERRUPTED:
-        fail(f"{scene_file}: {summary['message']}; frames up to then are in {folder}", EXIT_INTERRUPTED)
+        fail(f"{where}: {summary['message']}; frames up to then are in {folder}", EXIT_INTERRUPTED)
     if animate_:
         _animate(folder, None, quiet, fps=fps)
 
 
-def _check_time_step(scene, scene_file: Path, force: bool, quiet: bool) -> None:
+def _check_time_step(scene, where: str, force: bool, quiet: bool) -> None:
     """Refuse a dt above the stability bound (exit 2) unless --force; warn above 80 % of it."""
     from ..analysis.stability import WARN_FRACTION, time_step_verdict
     from ..model.build import build
@@ -94,7 +157,7 @@ def _check_time_step(scene, scene_file: Path, force: bool, quiet: bool) -> None:
 
     method, dt = scene.integrator.method, TimeGrid.of(scene).dt
     verdict, bound = time_step_verdict(build(scene), method, dt)
-    where = f"{scene_file}: integrator.dt = {dt:.4g} s"
+    where = f"{where}: integrator.dt = {dt:.4g} s"
     if verdict == "refuse" and not force:
         fail(f"{where} is above {method}'s stability bound {bound:.4g} s; use a smaller dt, method = \"sdirk2\" "
              f"(stable at any dt), or --force to run anyway")
@@ -103,16 +166,61 @@ def _check_time_step(scene, scene_file: Path, force: bool, quiet: bool) -> None:
                    f"(warning above {WARN_FRACTION:.0%})", err=True)
 
 
-@app.command()
+@app.command(cls=Command)
 def check(scene_file: SceneArg, sets: SetOpt = None) -> None:
     """Validate a scene and show what it contains and its stability bound, without running it."""
     from .report import print_check
 
-    scene = _load(scene_file, sets)
-    print_check(scene, scene_file)
+    scene, where = _load(scene_file, sets)
+    print_check(scene, where)
 
 
-@app.command()
+@app.command(cls=Command)
+def scenarios() -> None:
+    """List the built-in scenes, one a line: the name to give `ropesim run` and what the scene shows."""
+    from ..scene.builtin import builtin_names, builtin_path, describe
+
+    names = builtin_names()
+    width = max(map(len, names))
+    for name in names:
+        typer.echo(f"{name:<{width}}  {describe(builtin_path(name))}")
+
+
+@app.command(cls=Command)
+def new(
+    name: Annotated[str, typer.Argument(metavar="NAME", help="The new scene's name; it is written to NAME.toml "
+                                                             "(or give a path ending in .toml).",
+                                        show_default=False)],
+    from_: Annotated[str, typer.Option("--from", "-f", metavar="SCENE",
+                                       help="The built-in scene (or scene file) to start from.")] = "helicopter_mass",
+    force: Annotated[bool, typer.Option("--force", help="Replace NAME.toml if it exists.")] = False,
+) -> None:
+    """Write a scene file to edit: a copy of a built-in scene, every key explained by a comment.
+
+    The copy keeps the original's comments, puts each key's meaning and unit above it, and lists the optional
+    keys it leaves out, commented out at their defaults. Then: ropesim check NAME.toml; ropesim run NAME.toml.
+    """
+    from ..io.trajectory import write_text_atomic
+    from ..scene.builtin import NAME, annotated_copy
+
+    target = Path(name) if name.endswith(".toml") else Path(f"{name}.toml")
+    stem = target.stem
+    if not NAME.match(stem):
+        fail(f"NAME {name}: use letters, digits, '_', '-' or '.', starting with a letter or digit "
+             f"(it names the file and the run folder runs/{stem}/)")
+    if target.exists() and not force:
+        fail(f"{target}: exists; choose another NAME or add --force to replace it")
+    source = _source(from_)
+    _load(from_, None)  # the source must itself be a valid scene
+    try:
+        write_text_atomic(target, annotated_copy(source.path, stem))
+    except OSError as exc:
+        fail(f"{target}: cannot write ({exc.strerror or exc})")
+    typer.echo(f"{target}: a copy of {source.label} to edit; then `ropesim check {target}` and "
+               f"`ropesim run {target}`")
+
+
+@app.command(cls=Command)
 def sweep(
     scene_file: SceneArg,
     sets: Annotated[Optional[list[str]], typer.Option(
@@ -142,8 +250,8 @@ def sweep(
     from ..sweep.core import SweepError, run_sweep
 
     try:
-        result = run_sweep(scene_file, sets or [], out=out, jobs=jobs, scheduler=scheduler, plots=plots or [],
-                           quiet=quiet)
+        result = run_sweep(_source(scene_file).path, sets or [], out=out, jobs=jobs, scheduler=scheduler,
+                           plots=plots or [], quiet=quiet)
     except SweepError as exc:
         fail(str(exc))
     if not quiet:
@@ -158,7 +266,7 @@ def sweep(
 
 # ------------------------------------------------------------------------- pictures (ropesim.render)
 
-RunDirArg = Annotated[Path, typer.Argument(help="Run folder written by `ropesim run`, e.g. runs/helicopter_mass.",
+RunDirArg = Annotated[Path, typer.Argument(metavar="RUN_DIR", help="Run folder written by `ropesim run`, e.g. runs/helicopter_mass.",
                                            show_default=False)]
 FollowOpt = Annotated[bool, typer.Option("--follow", help="View from the driven node (the helicopter): "
                                                           "positions relative to it.")]
@@ -207,7 +315,7 @@ def _animate(run_dir: Path, out: Optional[Path], quiet: bool, **options) -> None
                    f"{result.size[0]}x{result.size[1]} px")
 
 
-@app.command()
+@app.command(cls=Command)
 def animate(
     run_dir: RunDirArg,
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output file, .gif or .mp4 (default "
@@ -227,7 +335,7 @@ def animate(
     _animate(run_dir, out, quiet, fps=fps, speed=speed, start=start, end=end, follow=follow, view=view, size=size)
 
 
-@app.command()
+@app.command(cls=Command)
 def frames(
     run_dir: RunDirArg,
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output PNG (default RUN_DIR/frames.png).",
@@ -259,7 +367,7 @@ def frames(
                    f"{result.size[0]}x{result.size[1]} px")
 
 
-@app.command()
+@app.command(cls=Command)
 def plot(
     run_dir: RunDirArg,
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output PNG (default RUN_DIR/plots.png).",
@@ -310,7 +418,7 @@ def _numbers(text: str | None, option: str) -> list[float] | None:
     return values
 
 
-@app.command()
+@app.command(cls=Command)
 def accuracy(
     scene_file: SceneArg,
     methods: MethodsOpt = None,
@@ -331,7 +439,7 @@ def accuracy(
     from ..analysis.accuracy import accuracy_report, plot, write_csv
     from .report import print_accuracy
 
-    scene = _load(scene_file, sets)
+    scene, _ = _load(scene_file, sets)
     names, ladder = _methods(methods), _numbers(dts, "--dts")
     folder = out if out is not None else Path("runs") / f"accuracy-{scene.name}"
     report = accuracy_report(scene, names, ladder, repeats)
@@ -344,7 +452,7 @@ def accuracy(
     print_accuracy(report, folder)
 
 
-@app.command()
+@app.command(cls=Command)
 def stability(
     scene_file: SceneArg,
     methods: MethodsOpt = None,
@@ -368,7 +476,7 @@ def stability(
     from ..analysis.stability import plot_sweep, stability_sweep, write_sweep
     from .report import print_stability
 
-    scene = _load(scene_file, sets)
+    scene, _ = _load(scene_file, sets)
     names, ladder = _methods(methods), _numbers(fractions, "--fractions")
     ks = _numbers(stiffness, "--k")
     folder = out if out is not None else Path("runs") / f"stability-{scene.name}"
