@@ -287,6 +287,34 @@ FpsOpt = Annotated[float, typer.Option(
 QuietOpt = Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")]
 
 
+def _open_run(run_dir: Path, command: str):
+    """The run folder ``run_dir``, opened lazily; a scene (a file, or a built-in's name) given where a run folder
+    belongs is told apart from a missing folder, in one line that says what to run (exit 2)."""
+    from ..io.trajectory import TRAJECTORY, RunFolderError, Trajectory
+    from ..scene.builtin import builtin_path, looks_like_a_name
+
+    scene = run_dir if run_dir.is_file() else None
+    if scene is None and not run_dir.exists() and looks_like_a_name(str(run_dir)):
+        scene = builtin_path(str(run_dir))
+    if scene is not None:
+        import tomllib
+
+        try:
+            name = str(tomllib.loads(scene.read_text(encoding="utf-8")).get("name", scene.stem))
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+            fail(f"{run_dir}: is a file, not a run folder (a folder written by `ropesim run`)")
+        what = "a scene file" if scene == run_dir else "a built-in scene"
+        made = Path("runs") / name
+        if (made / TRAJECTORY).is_file():
+            fail(f"{run_dir}: is {what}, not a run folder; its run is in {made}: `ropesim {command} {made}`")
+        fail(f"{run_dir}: is {what}, not a run folder; run it first: `ropesim run {run_dir}` writes {made}, "
+             f"then `ropesim {command} {made}`")
+    try:
+        return Trajectory.open(run_dir)
+    except RunFolderError as exc:
+        fail(str(exc))
+
+
 def _picture(make):
     """Call ``make()``; an unusable run folder or request, or an unwritable output, prints one line, exits 2."""
     from ..render import RenderError
@@ -304,11 +332,10 @@ def _picture(make):
 
 def _animate(run_dir: Path, out: Optional[Path], quiet: bool, **options) -> None:
     from ..render.animate import animate as make
-    from ..io.trajectory import Trajectory
-
+    traj = _open_run(run_dir, "animate")
     target = out if out is not None else run_dir / "animation.gif"
     note = (lambda message: typer.echo(f"ropesim: {message}", err=True))
-    result = _picture(lambda: make(Trajectory.open(run_dir), target, progress=not quiet and sys.stderr.isatty(),
+    result = _picture(lambda: make(traj, target, progress=not quiet and sys.stderr.isatty(),
                                    note=note, **options))
     if not quiet:
         typer.echo(f"{result.path}: {result.frames} frames at {result.fps:.3g} fps, "
@@ -344,7 +371,8 @@ def frames(
                                                  "0,0.5,1,2,3 (the nearest saved frames).",
                                                  show_default=False)] = None,
     count: Annotated[Optional[int], typer.Option("--count", help="Or this many frames evenly spaced from start "
-                                                 "to end (default 6).", show_default=False)] = None,
+                                                 "to end (default 6; a run with fewer saved frames shows them "
+                                                 "all).", show_default=False)] = None,
     overlay: Annotated[bool, typer.Option("--overlay", help="All frames on one view, fading from the first to "
                                                             "the last, instead of side by side.")] = False,
     follow: FollowOpt = False,
@@ -356,11 +384,10 @@ def frames(
     """One PNG of selected frames of a run, side by side or overlaid."""
     from ..render.frames import frame_sheet
     from ..render.timeline import parse_times
-    from ..io.trajectory import Trajectory
-
+    traj = _open_run(run_dir, "frames")
     target = out if out is not None else run_dir / "frames.png"
     result = _picture(lambda: frame_sheet(
-        Trajectory.open(run_dir), target, times=None if times is None else parse_times(times), count=count,
+        traj, target, times=None if times is None else parse_times(times), count=count,
         overlay=overlay, follow=follow, view=view, columns=columns, width=width))
     if not quiet:
         typer.echo(f"{result.path}: t = {', '.join(f'{t:.3g}' for t in result.times)} s, "
@@ -380,10 +407,9 @@ def plot(
     shooter's loop inclination over time.
     """
     from ..render.plots import plot_run
-    from ..io.trajectory import Trajectory
-
+    traj = _open_run(run_dir, "plot")
     target = out if out is not None else run_dir / "plots.png"
-    result = _picture(lambda: plot_run(Trajectory.open(run_dir), target))
+    result = _picture(lambda: plot_run(traj, target))
     if not quiet:
         typer.echo(f"{result.path}: {', '.join(result.panels)}")
 

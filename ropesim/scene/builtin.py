@@ -57,7 +57,8 @@ class SceneSource:
         return f"built-in scene {self.path.stem}" if self.builtin else str(self.path)
 
 
-def _looks_like_a_name(text: str) -> bool:
+def looks_like_a_name(text: str) -> bool:
+    """Whether a command-line argument could be a built-in's name (no folder in it)."""
     return "/" not in text and "\\" not in text
 
 
@@ -79,7 +80,7 @@ def resolve(arg: str | Path) -> SceneSource:
     path = Path(arg)
     if path.exists():
         return SceneSource(path)
-    if _looks_like_a_name(text):
+    if looks_like_a_name(text):
         found = builtin_path(text)
         if found is not None:
             return SceneSource(found, builtin=True)
