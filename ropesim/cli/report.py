@@ -7,6 +7,7 @@ from pathlib import Path
 from rich import box
 from rich.console import Console
 from rich.table import Table
+from rich.text import Text
 
 from ..scene.schema import Scene
 
@@ -38,11 +39,11 @@ def print_figures(console: Console, title: str, columns: list[str], rows: list[l
         label = title + (f" ({n + 1} of {len(parts)})" if len(parts) > 1 else "")
         table = Table(title=label, title_justify="left", box=box.SIMPLE_HEAD, show_edge=False, padding=(0, 0))
         for i in part:
-            table.add_column(columns[i], justify="left" if i in left else "right", no_wrap=True)
+            table.add_column(Text(columns[i]), justify="left" if i in left else "right", no_wrap=True)
         for k, row in enumerate(rows):
             if k and row[0]:
                 table.add_section()
-            table.add_row(*(row[i] for i in part))
+            table.add_row(*(Text(row[i]) for i in part))
         console.print(table)
 
 
