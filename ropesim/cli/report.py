@@ -28,6 +28,7 @@ def print_figures(console: Console, title: str, columns: list[str], rows: list[l
     def width(i: int) -> int:
         return max(len(line) for cell in [columns[i], *(r[i] for r in rows)] for line in cell.splitlines() or [""])
 
+    grouped = any(not row[0] for row in rows)   # some first cells left blank: set the groups apart
     parts, part = [], list(range(keys))
     for i in range(keys, len(columns)):
         if part[keys:] and sum(map(width, part + [i])) + len(part) > console.width:
@@ -41,7 +42,7 @@ def print_figures(console: Console, title: str, columns: list[str], rows: list[l
         for i in part:
             table.add_column(Text(columns[i]), justify="left" if i in left else "right", no_wrap=True)
         for k, row in enumerate(rows):
-            if k and row[0]:
+            if k and row[0] and grouped:
                 table.add_section()
             table.add_row(*(Text(row[i]) for i in part))
         console.print(table)
