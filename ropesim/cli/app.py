@@ -104,15 +104,11 @@ def _source(scene: str):
 
 def _load(scene: str, sets: list[str] | None):
     """The scene a SCENE argument means, validated, with ``--set`` applied, and how to name it in messages."""
-    from ..scene.loader import SceneError, load_scene, scene_from_toml
+    from ..scene.loader import SceneError, load_scene
 
     source = _source(scene)
     try:
-        if source.builtin:
-            text = source.path.read_text(encoding="utf-8")
-            return scene_from_toml(text, source=source.label, default_name=source.path.stem,
-                                   overrides=sets or []), source.label
-        return load_scene(source.path, sets or []), source.label
+        return load_scene(scene, sets or []), source.label
     except SceneError as exc:
         fail(str(exc))
 
