@@ -95,6 +95,7 @@ def test_new_writes_an_annotated_copy_that_loads_as_the_same_scene(tmp_path, mon
     assert replace(load_scene(written), name=source) == load_scene(builtin_folder() / f"{source}.toml")
     assert load_scene(written).name == "my_scene"
     text = written.read_text()
+    assert text.startswith(f"# my_scene: a scene to edit, copied from built-in scene {source} by `ropesim new`")
     original = (builtin_folder() / f"{source}.toml").read_text()
     for line in original.splitlines():   # every comment of the original is kept
         if line.lstrip().startswith("#"):
@@ -117,7 +118,11 @@ def test_new_refuses_to_overwrite_or_a_bad_name(tmp_path, monkeypatch):
     assert "did you mean shooter_low?" in one_line_error(invoke("new", "b", "--from", "shooter_lo"))
     assert not Path("b.toml").exists()
     Path("sub").mkdir()
-    assert invoke("new", "sub/c.toml").exit_code == 0 and load_scene("sub/c.toml").name == "c"
+    assert invoke("new", "sub/c.toml", "--from", "a.toml").exit_code == 0 and load_scene("sub/c.toml").name == "c"
+    copy = Path("sub/c.toml").read_text()
+    assert copy.startswith("# c: a scene to edit, copied from a.toml by")
+    first = Path("a.toml").read_text().splitlines()[5:]   # a copy of a copy: a new header, nothing else added
+    assert copy.splitlines()[5:] == [line.replace('name = "a"', 'name = "c"') for line in first]
 
 
 def test_resolve_raises_a_scene_error():

@@ -214,7 +214,7 @@ def new(
     source = _source(from_)
     _load(from_, None)  # the source must itself be a valid scene
     try:
-        write_text_atomic(target, annotated_copy(source.path, stem))
+        write_text_atomic(target, annotated_copy(source.path, stem, source.label))
     except OSError as exc:
         fail(f"{target}: cannot write ({exc.strerror or exc})")
     typer.echo(f"{target}: a copy of {source.label} to edit; then `ropesim check {target}` and "

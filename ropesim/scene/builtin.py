@@ -93,6 +93,8 @@ def resolve(arg: str | Path) -> SceneSource:
 _KEY = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)\s*=")
 _HEADER = re.compile(r"^\[(\[?)\s*([A-Za-z_][A-Za-z0-9_]*)\s*\]\]?\s*(#.*)?$")
 NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+_OUR_HEADER = re.compile(r"^# \S+: a scene to edit, copied from .* by `ropesim new`")
+HEADER_LINES = 5  # the header annotated_copy writes, with the blank line after it
 
 
 def _keys(table: str | None, raw: dict) -> dict:
@@ -118,7 +120,7 @@ def _doc(spec) -> str:
     return text
 
 
-def annotated_copy(source: Path, name: str) -> str:
+def annotated_copy(source: Path, name: str, label: str | None = None) -> str:
     """The text of scene file ``source`` as a new scene ``name``, to edit: a header saying where it came from,
     its own comments kept, a comment line above every key from the schema (meaning, unit, choices), and the
     optional keys it leaves out listed, commented out, at their defaults."""
@@ -131,8 +133,11 @@ def annotated_copy(source: Path, name: str) -> str:
 
     text = source.read_text(encoding="utf-8")
     raw = tomllib.loads(text)
-    out = [f"# {name}: a scene to edit, copied from the built-in scene {source.stem} by `ropesim new` "
-           f"(ropesim {__version__}).",
+    lines = text.splitlines()
+    if lines and _OUR_HEADER.match(lines[0]):   # a copy of a copy: its old header goes, its notes stay
+        lines = lines[HEADER_LINES:]
+    present = set(lines)
+    out = [f"# {name}: a scene to edit, copied from {label or source} by `ropesim new` (ropesim {__version__}).",
            f"# Check it with `ropesim check {name}.toml`, run it with `ropesim run {name}.toml`. Units are SI; x is",
            "# horizontal, y points up. Each key has its meaning above it; optional keys left out are shown",
            "# commented out at their defaults. The original file's comments follow.",
@@ -145,12 +150,12 @@ def annotated_copy(source: Path, name: str) -> str:
             return
         missing = [(k, spec, default) for k, (spec, default) in _keys(table, raw).items()
                    if k not in seen and k != "shape" and default is not MISSING and default is not None]
-        lines = [f"# {k} = {tomli_w.dumps({k: list(d) if isinstance(d, tuple) else d}).split('= ', 1)[1].strip()}"
+        shown = [f"# {k} = {tomli_w.dumps({k: list(d) if isinstance(d, tuple) else d}).split('= ', 1)[1].strip()}"
                  f"   # {_doc(spec)}" for k, spec, default in missing for d in [default]]
-        out[last_key + 1:last_key + 1] = lines
+        out[last_key + 1:last_key + 1] = [line for line in shown if line not in present]
 
     named = False
-    for line in text.splitlines():
+    for line in lines:
         header = _HEADER.match(line)
         key = _KEY.match(line)
         if header:
@@ -163,7 +168,7 @@ def annotated_copy(source: Path, name: str) -> str:
                 line, named = f'name = "{name}"', True
             if table == "initial" and k == "shape":
                 spec = S.Spec("str", "initial shape", choices=tuple(S.INITIAL_SHAPES))
-            if spec is not None:
+            if spec is not None and out[-1] != f"# {_doc(spec)}":
                 out.append(f"# {_doc(spec)}")
             seen.add(k)
             out.append(line)
@@ -172,5 +177,5 @@ def annotated_copy(source: Path, name: str) -> str:
         out.append(line)
     close_table()
     if not named:
-        out.insert(5, f'name = "{name}"')
+        out.insert(HEADER_LINES, f'name = "{name}"')
     return "\n".join(out) + "\n"
