@@ -47,7 +47,7 @@ def test_the_accuracy_table_never_cuts_a_figure(columns, monkeypatch, capsys):
         assert figure in words, (figure, columns)
     for method in METHODS:
         assert method in words
-    assert ("(1 of" in " ".join(words)) == (columns < 80)   # at 80 columns the whole table fits; narrower, it is printed in parts
+    assert ("(1 of" in " ".join(words)) == (columns < 80)   # 80 columns hold the whole table; fewer, it comes in parts
 
 
 def test_the_stability_table_never_cuts_a_figure(monkeypatch, capsys):

@@ -267,8 +267,8 @@ def sweep(
 
 # ------------------------------------------------------------------------- pictures (ropesim.render)
 
-RunDirArg = Annotated[Path, typer.Argument(metavar="RUN_DIR", help="Run folder written by `ropesim run`, e.g. runs/helicopter_mass.",
-                                           show_default=False)]
+RunDirArg = Annotated[Path, typer.Argument(metavar="RUN_DIR", help="Run folder written by `ropesim run`, e.g. "
+                                                                   "runs/helicopter_mass.", show_default=False)]
 FollowOpt = Annotated[bool, typer.Option("--follow", help="View from the driven node (the helicopter): "
                                                           "positions relative to it.")]
 ViewOpt = Annotated[Optional[str], typer.Option(

@@ -90,8 +90,8 @@ def picture_title(fig, model: Model, proj: Projection) -> None:
     handles = legend_handles(model)
     if handles:
         fig.legend(handles=handles, loc="upper left", bbox_to_anchor=(4 / fig.bbox.width, 1 - 17 / height),
-                   ncol=len(handles), frameon=False, fontsize=7, handletextpad=0.2, columnspacing=1.0, borderaxespad=0.0,
-                   borderpad=0.2)
+                   ncol=len(handles), frameon=False, fontsize=7, handletextpad=0.2, columnspacing=1.0,
+                   borderaxespad=0.0, borderpad=0.2)
 
 
 @with_picture_text
