@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
+import ropesim
 from typer.testing import CliRunner
 
 from ropesim.model.build import build
@@ -295,17 +297,43 @@ def test_check_lists_the_parts_of_a_shooter():
 
 
 @pytest.mark.parametrize("args,fragments", [
-    (["--help"], ["run", "check", "ropesim run scenarios/helicopter_mass.toml"]),
+    (["--help"], ["run", "check", "scenarios", "new", "ropesim run helicopter_mass", "--version"]),
     (["-h"], ["run", "check"]),
-    (["run", "--help"], ["scene_file", "--out", "runs/<scene name>/", "--set", "KEY=VALUE", "integrator.dt=0.002",
-                         "--quiet", "trajectory.npz"]),
-    (["check", "--help"], ["scene_file", "--set", "KEY=VALUE", "stability bound"]),
+    (["run", "--help"], ["SCENE", "built-in scene", "--out", "runs/<scene name>/", "--set", "KEY=VALUE",
+                         "integrator.dt=0.002", "--quiet", "trajectory.npz"]),
+    (["check", "--help"], ["SCENE", "--set", "KEY=VALUE", "stability bound"]),
+    (["export", "--help"], ["pip install 'ropesim[export]'", "(t [s], node, x [m]", "NetCDF is not offered"]),
 ])
 def test_help(args, fragments):
     result = invoke(*args)
     assert result.exit_code == 0, result.output
     for fragment in fragments:
         assert fragment in result.stdout, fragment
+
+
+def _commands() -> list[str]:
+    from typer.main import get_command
+
+    return sorted(get_command(app).commands)
+
+
+@pytest.mark.parametrize("columns", ["80", "200"])
+def test_every_help_shows_flags_without_a_type_and_paragraphs_unbroken(columns):
+    """A flag takes no value, so help shows no `<bool>` after it; a docstring's paragraph is wrapped to the
+    terminal, never broken where its source lines ended (a line shorter than the width, then more words)."""
+    for args in [["--help"]] + [[name, "--help"] for name in _commands()]:
+        result = runner.invoke(app, args, env={"COLUMNS": columns})
+        assert result.exit_code == 0, (args, result.output)
+        assert "<bool>" not in result.stdout, args
+        assert re.search(r"--help\s+-h\s+Show this message", result.stdout), args
+    wide = runner.invoke(app, ["plot", "--help"], env={"COLUMNS": "200"}).stdout
+    assert "against the exact steady state; a string shooter's loop inclination over time." in wide
+
+
+def test_version():
+    for flag in ("--version", "-V"):
+        result = invoke(flag)
+        assert result.exit_code == 0 and result.stdout == f"ropesim {ropesim.__version__}\n"
 
 
 # ---------------------------------------------------------------------------- real processes

@@ -80,6 +80,25 @@ def test_frames_and_plot_write_pngs_in_the_run_folder(runs, tmp_path):
     assert (folder / "plots.png").is_file()
 
 
+def test_frames_shows_every_frame_of_a_run_with_fewer_than_asked(runs, tmp_path):
+    four = invoke("run", SCENARIOS / "helicopter_mass.toml", "--set", "integrator.t_end=0.03", "-o", tmp_path / "r",
+                  "-q")
+    assert four.exit_code == 0, four.output
+    for extra in ([], ["--count", "10"]):   # the default 6, or more than the 4 saved frames
+        result = invoke("frames", tmp_path / "r", *extra)
+        assert result.exit_code == 0, result.output
+        assert "t = 0, 0.01, 0.02, 0.03 s" in result.stdout
+
+
+def test_a_scene_where_a_run_folder_belongs_points_to_its_run(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert invoke("run", "helicopter_mass", "--set", "integrator.t_end=0.03", "-q").exit_code == 0
+    result = invoke("animate", "helicopter_mass")
+    assert result.exit_code == 2 and result.stderr.splitlines() == [
+        "ropesim: helicopter_mass: is a built-in scene, not a run folder; its run is in runs/helicopter_mass: "
+        "`ropesim animate runs/helicopter_mass`"]
+
+
 def _corrupt(folder: Path) -> Path:
     (folder / "trajectory.npz").write_bytes(b"PK\x03\x04 not really a zip")
     return folder
@@ -103,7 +122,12 @@ BAD = [
     (["frames", "{heli}", "-o", "{out}/a.png", "--times", "0,1"], "--times 1: outside the run"),
     (["frames", "{heli}", "-o", "{out}/a.png", "--times", "0,soon"], "'soon' is not a number"),
     (["frames", "{heli}", "-o", "{out}/a.png", "--times", "0", "--count", "3"], "one or the other"),
-    (["frames", "{heli}", "-o", "{out}/a.png", "--count", "99"], "only 31 frames"),
+    (["animate", str(SCENARIOS / "helicopter_parachute.toml"), "-o", "{out}/a.gif"],
+     "helicopter_parachute.toml: is a scene file, not a run folder; run it first: `ropesim run "),
+    (["frames", "shooter_vacuum", "-o", "{out}/a.png"],
+     "shooter_vacuum: is a built-in scene, not a run folder; run it first: `ropesim run shooter_vacuum` writes "
+     "runs/shooter_vacuum, then `ropesim frames runs/shooter_vacuum`"),
+    (["plot", "{out}/../corrupt/trajectory.npz", "-o", "{out}/a.png"], "is a file, not a run folder"),
 ]
 
 

@@ -27,6 +27,7 @@ from ..model.build import build
 from ..integrate.health import E0, OK, STATUS_NAMES
 from ..integrate.methods import METHODS, get_method
 from ..scene.schema import Scene
+from ..render.style import with_picture_text
 from .stability import predicted_dt
 
 REFERENCE_METHOD = "pefrl"
@@ -187,16 +188,15 @@ def write_csv(report: Report, path) -> None:
     write_text_atomic(path, buf.getvalue())
 
 
-def plot(report: Report, path) -> None:
-    """Work-precision figure: largest position error against kernel wall time and against force evaluations."""
-    import matplotlib
+def work_precision_figure(report: Report):
+    """Work-precision figure: largest position error against kernel wall time and against force evaluations.
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    One legend for both panels, below them (never over a point); none if no method completed.
+    """
+    from matplotlib.figure import Figure
 
-    from ..io.atomic import atomic_output
-
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), constrained_layout=True)
+    fig = Figure(figsize=(11, 4.8), layout="constrained")
+    axes = fig.subplots(1, 2)
     for name in dict.fromkeys(r.method for r in report.rows):
         ok = [r for r in report.rows if r.method == name and r.status == "completed" and r.error_max > 0]
         if not ok:
@@ -212,8 +212,22 @@ def plot(report: Report, path) -> None:
         ax.set_xlabel(xlabel)
         ax.set_ylabel("largest node position error at t_end [m]")
         ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=8)
+    handles, labels = axes[0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labels, loc="outside lower center", ncol=min(len(handles), 3), fontsize=8,
+                   frameon=False)
+    else:
+        for ax in axes:
+            ax.text(0.5, 0.5, "no run completed", ha="center", va="center", transform=ax.transAxes)
     fig.suptitle(f"{report.scene.name}: work-precision to t = {report.t_end:g} s (dotted: reference floor)")
+    return fig
+
+
+@with_picture_text
+def plot(report: Report, path) -> None:
+    """Write :func:`work_precision_figure` to the PNG ``path``."""
+    from ..io.atomic import atomic_output
+
+    fig = work_precision_figure(report)
     with atomic_output(path) as tmp:
         fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)

@@ -26,9 +26,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.build import Model, spring_count
-from ..model.terms import declared_terms
 from ..integrate.base import stable_step
 from ..integrate.methods import METHODS, get_method
+from ..model.terms import declared_terms
+from ..render.style import with_picture_text
 
 SPECTRAL_MAX_NODES = 800
 WARN_FRACTION = 0.8       # `ropesim run` warns above this fraction of the bound, refuses above the bound
@@ -291,18 +292,15 @@ def write_sweep(result: SweepResult, folder) -> tuple:
     return tuple(paths)
 
 
-def plot_sweep(result: SweepResult, path) -> None:
-    """One row per method: probes at each dt (and k), the predicted bound (line) and the measured blow-up."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from ..io.atomic import atomic_output
+def stability_figure(result: SweepResult):
+    """One row per method: probes at each dt (and k), the predicted bound (line) and the measured blow-up; the
+    legend above the axes, never over a probe."""
+    from matplotlib.figure import Figure
 
     methods = list(dict.fromkeys(r["method"] for r in result.rows))
     ks = sorted({r["stiffness"] for r in result.rows})
-    fig, ax = plt.subplots(figsize=(9, 1.0 + 0.55 * len(methods) * len(ks)), constrained_layout=True)
+    fig = Figure(figsize=(9, 1.4 + 0.55 * len(methods) * len(ks)), layout="constrained")
+    ax = fig.subplots()
     labels = []
     y = 0
     for name in methods:
@@ -325,9 +323,17 @@ def plot_sweep(result: SweepResult, path) -> None:
             y += 1
     ax.set_yticks(range(len(labels)), labels)
     ax.invert_yaxis()
-    ax.set_xlabel("dt / (2 / omega_max)")
+    ax.set_xlabel("time step dt as a multiple of 2 / omega_max (omega_max [rad/s]: the fastest mode)")
     ax.grid(True, axis="x", alpha=0.3)
-    ax.legend(fontsize=8, loc="upper right", ncol=2)
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside upper center", ncol=5, fontsize=8, frameon=False)
+    return fig
+
+
+@with_picture_text
+def plot_sweep(result: SweepResult, path) -> None:
+    """Write :func:`stability_figure` to the PNG ``path``."""
+    from ..io.atomic import atomic_output
+
+    fig = stability_figure(result)
     with atomic_output(path) as tmp:
         fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)

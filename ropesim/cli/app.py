@@ -7,27 +7,64 @@ they computed.
 
 from __future__ import annotations
 
+import inspect
 import sys
 from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
+from typer.core import TyperCommand, TyperGroup
+
+from .. import __version__
+
+
+class _CleanHelp:
+    """Help as a person reads it: no type shown for a flag (typer 0.29 labels every flag <bool>, as if it took
+    a value: `--help -h <bool>`), a docstring's paragraphs wrapped to the terminal rather than broken where the
+    source lines end, and brackets shown as written ("[s]" is a unit, not rich's strike-through markup)."""
+
+    def __init__(self, *args, **kwargs):
+        from rich.markup import escape
+
+        super().__init__(*args, **kwargs)
+        if self.help:
+            self.help = escape("\n\n".join(" ".join(p.split()) for p in inspect.cleandoc(self.help).split("\n\n")))
+        for param in self.params:
+            if getattr(param, "help", None):
+                param.help = escape(param.help)
+
+    def get_params(self, ctx):
+        params = super().get_params(ctx)
+        for param in params:
+            if getattr(param, "is_flag", False) and param.metavar is None:
+                param.metavar = ""
+        return params
+
+
+class Command(_CleanHelp, TyperCommand):
+    pass
+
+
+class Group(_CleanHelp, TyperGroup):
+    pass
+
 
 app = typer.Typer(
     name="ropesim",
+    cls=Group,
     help="Simulate ropes: point masses joined by stiff springs, under gravity and air drag.\n\n"
-         "Scenes are TOML files (see scenarios/ and the README). Start with:\n\n"
-         "  ropesim run scenarios/helicopter_mass.toml",
+         "A scene is a TOML file or the name of a built-in scene (`ropesim scenarios` lists them). Start with:\n\n"
+         "  ropesim run helicopter_mass",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
     context_settings={"help_option_names": ["-h", "--help"]},
 )
-
 EXIT_BAD_INPUT, EXIT_BLEW_UP, EXIT_INTERRUPTED = 2, 3, 130
 
-SceneArg = Annotated[Path, typer.Argument(help="Scene file (TOML), e.g. scenarios/helicopter_mass.toml.",
-                                          show_default=False)]
+SceneArg = Annotated[str, typer.Argument(
+    metavar="SCENE", help="A scene file (TOML), or the name of a built-in scene such as helicopter_mass "
+                          "(`ropesim scenarios` lists them).", show_default=False)]
 SetOpt = Annotated[Optional[list[str]], typer.Option(
     "--set", "-s", metavar="KEY=VALUE",
     help="Override a scene key by its dotted TOML path, typed and validated like the file; repeatable. "
@@ -40,16 +77,43 @@ def fail(message: str, code: int = EXIT_BAD_INPUT) -> None:
     raise typer.Exit(code)
 
 
-def _load(scene_file: Path, sets: list[str] | None):
-    from ..scene.loader import SceneError, load_scene
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(f"ropesim {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(
+    version: Annotated[bool, typer.Option("--version", "-V", callback=_version, is_eager=True,
+                                          help="Print ropesim's version and exit.")] = False,
+) -> None:
+    pass  # the app's options only (its help is the Typer's help above)
+
+
+def _source(scene: str):
+    """The scene file a SCENE argument means (a path, or a built-in's name); one line and exit 2 if none."""
+    from ..scene.builtin import resolve
+    from ..scene.loader import SceneError
 
     try:
-        return load_scene(scene_file, sets or [])
+        return resolve(scene)
     except SceneError as exc:
         fail(str(exc))
 
 
-@app.command()
+def _load(scene: str, sets: list[str] | None):
+    """The scene a SCENE argument means, validated, with ``--set`` applied, and how to name it in messages."""
+    from ..scene.loader import SceneError, load_scene
+
+    source = _source(scene)
+    try:
+        return load_scene(scene, sets or []), source.label
+    except SceneError as exc:
+        fail(str(exc))
+
+
+@app.command(cls=Command)
 def run(
     scene_file: SceneArg,
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Run folder (default runs/<scene name>/).",
@@ -66,8 +130,8 @@ def run(
     from .report import print_summary
     from ..run import BLEW_UP, INTERRUPTED, simulate
 
-    scene = _load(scene_file, sets)
-    _check_time_step(scene, scene_file, force, quiet)
+    scene, where = _load(scene_file, sets)
+    _check_time_step(scene, where, force, quiet)
     folder = out if out is not None else Path("runs") / scene.name
     if folder.exists() and not folder.is_dir():
         fail(f"--out {folder}: exists and is not a folder")
@@ -79,14 +143,14 @@ def run(
     if not quiet:
         print_summary(summary, folder)
     if summary["status"] == BLEW_UP:
-        fail(f"{scene_file}: {summary['message']}; frames up to then are in {folder}", EXIT_BLEW_UP)
+        fail(f"{where}: {summary['message']}; frames up to then are in {folder}", EXIT_BLEW_UP)
     if summary["status"] == INTERRUPTED:
-        fail(f"{scene_file}: {summary['message']}; frames up to then are in {folder}", EXIT_INTERRUPTED)
+        fail(f"{where}: {summary['message']}; frames up to then are in {folder}", EXIT_INTERRUPTED)
     if animate_:
         _animate(folder, None, quiet, fps=fps)
 
 
-def _check_time_step(scene, scene_file: Path, force: bool, quiet: bool) -> None:
+def _check_time_step(scene, where: str, force: bool, quiet: bool) -> None:
     """Refuse a dt above the stability bound (exit 2) unless --force; warn above 80 % of it."""
     from ..analysis.stability import WARN_FRACTION, time_step_verdict
     from ..model.build import build
@@ -94,7 +158,7 @@ def _check_time_step(scene, scene_file: Path, force: bool, quiet: bool) -> None:
 
     method, dt = scene.integrator.method, TimeGrid.of(scene).dt
     verdict, bound = time_step_verdict(build(scene), method, dt)
-    where = f"{scene_file}: integrator.dt = {dt:.4g} s"
+    where = f"{where}: integrator.dt = {dt:.4g} s"
     if verdict == "refuse" and not force:
         fail(f"{where} is above {method}'s stability bound {bound:.4g} s; use a smaller dt, method = \"sdirk2\" "
              f"(stable at any dt), or --force to run anyway")
@@ -103,16 +167,61 @@ def _check_time_step(scene, scene_file: Path, force: bool, quiet: bool) -> None:
                    f"(warning above {WARN_FRACTION:.0%})", err=True)
 
 
-@app.command()
+@app.command(cls=Command)
 def check(scene_file: SceneArg, sets: SetOpt = None) -> None:
     """Validate a scene and show what it contains and its stability bound, without running it."""
     from .report import print_check
 
-    scene = _load(scene_file, sets)
-    print_check(scene, scene_file)
+    scene, where = _load(scene_file, sets)
+    print_check(scene, where)
 
 
-@app.command()
+@app.command(cls=Command)
+def scenarios() -> None:
+    """List the built-in scenes, one a line: the name to give `ropesim run` and what the scene shows."""
+    from ..scene.builtin import builtin_names, builtin_path, describe
+
+    names = builtin_names()
+    width = max(map(len, names))
+    for name in names:
+        typer.echo(f"{name:<{width}}  {describe(builtin_path(name))}")
+
+
+@app.command(cls=Command)
+def new(
+    name: Annotated[str, typer.Argument(metavar="NAME", help="The new scene's name; it is written to NAME.toml "
+                                                             "(or give a path ending in .toml).",
+                                        show_default=False)],
+    from_: Annotated[str, typer.Option("--from", "-f", metavar="SCENE",
+                                       help="The built-in scene (or scene file) to start from.")] = "helicopter_mass",
+    force: Annotated[bool, typer.Option("--force", help="Replace NAME.toml if it exists.")] = False,
+) -> None:
+    """Write a scene file to edit: a copy of a built-in scene, every key explained by a comment.
+
+    The copy keeps the original's comments, puts each key's meaning and unit above it, and lists the optional
+    keys it leaves out, commented out at their defaults. Then: ropesim check NAME.toml; ropesim run NAME.toml.
+    """
+    from ..io.trajectory import write_text_atomic
+    from ..scene.builtin import NAME, annotated_copy
+
+    target = Path(name) if name.endswith(".toml") else Path(f"{name}.toml")
+    stem = target.stem
+    if not NAME.match(stem):
+        fail(f"NAME {name}: use letters, digits, '_', '-' or '.', starting with a letter or digit "
+             f"(it names the file and the run folder runs/{stem}/)")
+    if target.exists() and not force:
+        fail(f"{target}: exists; choose another NAME or add --force to replace it")
+    source = _source(from_)
+    _load(from_, None)  # the source must itself be a valid scene
+    try:
+        write_text_atomic(target, annotated_copy(source.path, stem, source.label))
+    except OSError as exc:
+        fail(f"{target}: cannot write ({exc.strerror or exc})")
+    typer.echo(f"{target}: a copy of {source.label} to edit; then `ropesim check {target}` and "
+               f"`ropesim run {target}`")
+
+
+@app.command(cls=Command)
 def sweep(
     scene_file: SceneArg,
     sets: Annotated[Optional[list[str]], typer.Option(
@@ -143,8 +252,8 @@ def sweep(
     from ..sweep.plan import SweepError
 
     try:
-        result = run_sweep(scene_file, sets or [], out=out, jobs=jobs, scheduler=scheduler, plots=plots or [],
-                           quiet=quiet)
+        result = run_sweep(_source(scene_file).path, sets or [], out=out, jobs=jobs, scheduler=scheduler,
+                           plots=plots or [], quiet=quiet)
     except SweepError as exc:
         fail(str(exc))
     if not quiet:
@@ -159,8 +268,8 @@ def sweep(
 
 # ------------------------------------------------------------------------- pictures (ropesim.render)
 
-RunDirArg = Annotated[Path, typer.Argument(help="Run folder written by `ropesim run`, e.g. runs/helicopter_mass.",
-                                           show_default=False)]
+RunDirArg = Annotated[Path, typer.Argument(metavar="RUN_DIR", help="Run folder written by `ropesim run`, e.g. "
+                                                                   "runs/helicopter_mass.", show_default=False)]
 FollowOpt = Annotated[bool, typer.Option("--follow", help="View from the driven node (the helicopter): "
                                                           "positions relative to it.")]
 ViewOpt = Annotated[Optional[str], typer.Option(
@@ -180,6 +289,34 @@ FpsOpt = Annotated[float, typer.Option(
 QuietOpt = Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")]
 
 
+def _open_run(run_dir: Path, command: str):
+    """The run folder ``run_dir``, opened lazily; a scene (a file, or a built-in's name) given where a run folder
+    belongs is told apart from a missing folder, in one line that says what to run (exit 2)."""
+    from ..io.trajectory import TRAJECTORY, RunFolderError, Trajectory
+    from ..scene.builtin import builtin_path, looks_like_a_name
+
+    scene = run_dir if run_dir.is_file() else None
+    if scene is None and not run_dir.exists() and looks_like_a_name(str(run_dir)):
+        scene = builtin_path(str(run_dir))
+    if scene is not None:
+        import tomllib
+
+        try:
+            name = str(tomllib.loads(scene.read_text(encoding="utf-8")).get("name", scene.stem))
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+            fail(f"{run_dir}: is a file, not a run folder (a folder written by `ropesim run`)")
+        what = "a scene file" if scene == run_dir else "a built-in scene"
+        made = Path("runs") / name
+        if (made / TRAJECTORY).is_file():
+            fail(f"{run_dir}: is {what}, not a run folder; its run is in {made}: `ropesim {command} {made}`")
+        fail(f"{run_dir}: is {what}, not a run folder; run it first: `ropesim run {run_dir}` writes {made}, "
+             f"then `ropesim {command} {made}`")
+    try:
+        return Trajectory.open(run_dir)
+    except RunFolderError as exc:
+        fail(str(exc))
+
+
 def _picture(make):
     """Call ``make()``; an unusable run folder or request, or an unwritable output, prints one line, exits 2."""
     from ..render import RenderError
@@ -197,18 +334,17 @@ def _picture(make):
 
 def _animate(run_dir: Path, out: Optional[Path], quiet: bool, **options) -> None:
     from ..render.animate import animate as make
-    from ..io.trajectory import Trajectory
-
+    traj = _open_run(run_dir, "animate")
     target = out if out is not None else run_dir / "animation.gif"
     note = (lambda message: typer.echo(f"ropesim: {message}", err=True))
-    result = _picture(lambda: make(Trajectory.open(run_dir), target, progress=not quiet and sys.stderr.isatty(),
+    result = _picture(lambda: make(traj, target, progress=not quiet and sys.stderr.isatty(),
                                    note=note, **options))
     if not quiet:
         typer.echo(f"{result.path}: {result.frames} frames at {result.fps:.3g} fps, "
                    f"{result.size[0]}x{result.size[1]} px")
 
 
-@app.command()
+@app.command(cls=Command)
 def animate(
     run_dir: RunDirArg,
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output file, .gif or .mp4 (default "
@@ -228,7 +364,7 @@ def animate(
     _animate(run_dir, out, quiet, fps=fps, speed=speed, start=start, end=end, follow=follow, view=view, size=size)
 
 
-@app.command()
+@app.command(cls=Command)
 def frames(
     run_dir: RunDirArg,
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output PNG (default RUN_DIR/frames.png).",
@@ -237,7 +373,8 @@ def frames(
                                                  "0,0.5,1,2,3 (the nearest saved frames).",
                                                  show_default=False)] = None,
     count: Annotated[Optional[int], typer.Option("--count", help="Or this many frames evenly spaced from start "
-                                                 "to end (default 6).", show_default=False)] = None,
+                                                 "to end (default 6; a run with fewer saved frames shows them "
+                                                 "all).", show_default=False)] = None,
     overlay: Annotated[bool, typer.Option("--overlay", help="All frames on one view, fading from the first to "
                                                             "the last, instead of side by side.")] = False,
     follow: FollowOpt = False,
@@ -249,18 +386,17 @@ def frames(
     """One PNG of selected frames of a run, side by side or overlaid."""
     from ..render.frames import frame_sheet
     from ..render.timeline import parse_times
-    from ..io.trajectory import Trajectory
-
+    traj = _open_run(run_dir, "frames")
     target = out if out is not None else run_dir / "frames.png"
     result = _picture(lambda: frame_sheet(
-        Trajectory.open(run_dir), target, times=None if times is None else parse_times(times), count=count,
+        traj, target, times=None if times is None else parse_times(times), count=count,
         overlay=overlay, follow=follow, view=view, columns=columns, width=width))
     if not quiet:
         typer.echo(f"{result.path}: t = {', '.join(f'{t:.3g}' for t in result.times)} s, "
                    f"{result.size[0]}x{result.size[1]} px")
 
 
-@app.command()
+@app.command(cls=Command)
 def plot(
     run_dir: RunDirArg,
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output PNG (default RUN_DIR/plots.png).",
@@ -273,12 +409,49 @@ def plot(
     shooter's loop inclination over time.
     """
     from ..render.plots import plot_run
-    from ..io.trajectory import Trajectory
-
+    traj = _open_run(run_dir, "plot")
     target = out if out is not None else run_dir / "plots.png"
-    result = _picture(lambda: plot_run(Trajectory.open(run_dir), target))
+    result = _picture(lambda: plot_run(traj, target))
     if not quiet:
         typer.echo(f"{result.path}: {', '.join(result.panels)}")
+
+
+@app.command(cls=Command)
+def export(
+    run_dir: RunDirArg,
+    to: Annotated[str, typer.Option("--to", "-t", metavar="FORMAT", help="vtk: a series for ParaView (a .pvd and a "
+                                    ".vtu per frame; needs the export extra); csv: one table for spreadsheets.",
+                                    show_default=False)],
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", "-o", help="Output: a folder for vtk, a file for csv (default RUN_DIR/vtk/ or "
+                            "RUN_DIR/trajectory.csv).", show_default=False)] = None,
+    quiet: QuietOpt = False,
+) -> None:
+    """Export a run for the tools engineers use: a VTK series for ParaView, or CSV for spreadsheets.
+
+    vtk: one .vtu per saved frame (the nodes joined by line cells, with velocity and speed per node) and a .pvd
+    that lists them with their times: open the .pvd in ParaView and press play. Written with meshio (pip
+    install 'ropesim[export]'): 2 MB of pure Python that writes VTK's compressed XML correctly; pyvista would
+    bring all of VTK.
+
+    csv: long format, one row per node per frame, a header naming each column with its unit (t [s], node,
+    x [m], y [m], vx [m/s], vy [m/s]); full precision, so it reads back exactly.
+
+    NetCDF is not offered: xarray with h5py would add about 120 MB to hold the three arrays trajectory.npz
+    already holds (numpy.load reads it; xarray wraps it in one call).
+    """
+    from ..io.export import ExportError, export as write
+
+    traj = _open_run(run_dir, "export")
+    try:
+        result = write(traj, to.strip().lower(), out)
+    except ExportError as exc:
+        fail(str(exc))
+    except OSError as exc:
+        fail(f"{exc.filename or out or run_dir}: cannot write ({exc.strerror or exc})")
+    if not quiet:
+        typer.echo(f"{result.path}: {traj.frames} frames of {traj.nodes} nodes, {result.files} "
+                   f"file{'s' if result.files > 1 else ''}, {result.bytes / 1e3:,.0f} kB")
 
 
 MethodsOpt = Annotated[Optional[str], typer.Option(
@@ -311,7 +484,7 @@ def _numbers(text: str | None, option: str) -> list[float] | None:
     return values
 
 
-@app.command()
+@app.command(cls=Command)
 def accuracy(
     scene_file: SceneArg,
     methods: MethodsOpt = None,
@@ -332,7 +505,7 @@ def accuracy(
     from ..analysis.accuracy import accuracy_report, plot, write_csv
     from .report import print_accuracy
 
-    scene = _load(scene_file, sets)
+    scene, _ = _load(scene_file, sets)
     names, ladder = _methods(methods), _numbers(dts, "--dts")
     folder = out if out is not None else Path("runs") / f"accuracy-{scene.name}"
     report = accuracy_report(scene, names, ladder, repeats)
@@ -345,7 +518,7 @@ def accuracy(
     print_accuracy(report, folder)
 
 
-@app.command()
+@app.command(cls=Command)
 def stability(
     scene_file: SceneArg,
     methods: MethodsOpt = None,
@@ -369,7 +542,7 @@ def stability(
     from ..analysis.stability import plot_sweep, stability_sweep, write_sweep
     from .report import print_stability
 
-    scene = _load(scene_file, sets)
+    scene, _ = _load(scene_file, sets)
     names, ladder = _methods(methods), _numbers(fractions, "--fractions")
     ks = _numbers(stiffness, "--k")
     folder = out if out is not None else Path("runs") / f"stability-{scene.name}"

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from rich import box
 from rich.console import Console
 from rich.table import Table
+from rich.text import Text
 
 from ..scene.schema import Scene
 
@@ -14,11 +16,43 @@ def _console() -> Console:
     return Console(highlight=False)
 
 
+def print_figures(console: Console, title: str, columns: list[str], rows: list[list[str]], keys: int = 2,
+                  left: tuple[int, ...] = (0,)) -> None:
+    """A table of figures that stays readable at 80 columns and when piped (rich then assumes 80 columns).
+
+    No vertical rules, one space between columns, headers on two lines ("\\n" in a column name); the columns
+    ``left`` (names) on the left, the figures on the right. A figure is never wrapped or cut:
+    a table too wide for the terminal is printed in parts, each repeating the first ``keys`` columns. A row
+    whose first cell is "" starts no new group; a row with a new first cell is set off by a blank line.
+    """
+    def width(i: int) -> int:
+        return max(len(line) for cell in [columns[i], *(r[i] for r in rows)] for line in cell.splitlines() or [""])
+
+    grouped = any(not row[0] for row in rows)   # some first cells left blank: set the groups apart
+    parts, part = [], list(range(keys))
+    for i in range(keys, len(columns)):
+        if part[keys:] and sum(map(width, part + [i])) + len(part) > console.width:
+            parts.append(part)
+            part = list(range(keys))
+        part.append(i)
+    parts.append(part)
+    for n, part in enumerate(parts):
+        label = title + (f" ({n + 1} of {len(parts)})" if len(parts) > 1 else "")
+        table = Table(title=label, title_justify="left", box=box.SIMPLE_HEAD, show_edge=False, padding=(0, 0))
+        for i in part:
+            table.add_column(Text(columns[i]), justify="left" if i in left else "right", no_wrap=True)
+        for k, row in enumerate(rows):
+            if k and row[0] and grouped:
+                table.add_section()
+            table.add_row(*(Text(row[i]) for i in part))
+        console.print(table)
+
+
 def print_summary(summary: dict, folder: Path) -> None:
     """The run summary as a two-column table."""
     table = Table(title=f"{summary['scene']}: {summary['status']}", show_header=False, title_justify="left")
     table.add_column("", style="bold")
-    table.add_column("")
+    table.add_column("", overflow="fold")  # words wrap; a word too long for the column folds, never cut
     rows = [
         ("simulated", f"t = 0 .. {summary['t_end']:.6g} s, {summary['steps']} steps of {summary['dt']:.3g} s "
                       f"({summary['method']}), {summary['frames']} frames"),
@@ -77,7 +111,7 @@ def print_check(scene: Scene, source: Path) -> None:
     rope = scene.rope
     table = Table(title=f"{source}: valid scene '{scene.name}'", show_header=False, title_justify="left")
     table.add_column("", style="bold")
-    table.add_column("")
+    table.add_column("", overflow="fold")  # words wrap; a word too long for the column folds, never cut
     if scene.description:
         table.add_row("description", scene.description)
     table.add_row("rope", f"{rope.nodes} nodes, {'closed loop' if rope.closed else 'open line'}, "
@@ -159,17 +193,17 @@ def print_accuracy(report, folder: Path) -> None:
     from ..analysis.accuracy import REFERENCE_FLOOR
 
     ref = report.reference
-    table = Table(title=f"{report.scene.name}: error at t = {report.t_end:g} s against {ref.method} at dt = "
-                        f"{ref.dt:.3g} s", title_justify="left")
-    for col in ("method", "dt [s]", "largest error [m]", "RMS error [m]", "energy error [J]", "wall time [s]",
-                "force evals"):
-        table.add_column(col, justify="left" if col == "method" else "right")
+    rows, previous = [], None
     for r in report.rows:
-        err = f"{r.error_max:.3e}" + (" *" if r.at_floor else "") if r.status == "completed" else r.status
-        table.add_row(r.method, f"{r.dt:.4g}", err, f"{r.error_rms:.3e}", f"{r.energy_error:.3e}",
-                      f"{r.wall_time:.3g}", f"{r.force_evaluations:,}")
+        err = f"{r.error_max:.3e}" + ("*" if r.at_floor else "") if r.status == "completed" else r.status
+        rows.append([r.method if r.method != previous else "", f"{r.dt:.4g}", err, f"{r.error_rms:.3e}",
+                     f"{r.energy_error:.3e}", f"{r.wall_time:.3g}", f"{r.force_evaluations:,}"])
+        previous = r.method
     console = _console()
-    console.print(table)
+    print_figures(console, f"{report.scene.name}: error at t = {report.t_end:g} s against {ref.method} at dt = "
+                           f"{ref.dt:.3g} s",
+                  ["method", "dt [s]", "largest\nerror [m]", "RMS\nerror [m]", "energy\nerror [J]", "wall\ntime [s]",
+                   "force\nevals"], rows)
     console.print(f"reference: two refinements differ by {ref.difference:.2e} m; errors below "
                   f"{REFERENCE_FLOOR:g} x that (marked *) are left out of the orders")
     done = [r for r in report.rows if r.status == "completed"]
@@ -185,20 +219,23 @@ def print_accuracy(report, folder: Path) -> None:
 
 def print_stability(result, folder: Path) -> None:
     """Predicted bounds against measured blow-up time steps."""
-    table = Table(title="stability: predicted bound against measured blow-up", title_justify="left")
-    for col in ("k [N/m]", "method", "bound [s]", "Gershgorin [s]", "measured blow-up [s]", "bound / measured"):
-        table.add_column(col, justify="left" if col == "method" else "right")
+    rows, previous = [], None
     for b in result.bounds:
+        k = f"{b['stiffness']:g}"
+        row = [k if k != previous else "", b["method"]]
+        previous = k
         if b["predicted_dt_spectral"] == float("inf"):
-            table.add_row(f"{b['stiffness']:g}", b["method"], "none", "none",
-                          "none" if b["measured_blowup_dt"] == float("inf") else f"{b['measured_blowup_dt']:.4g}", "")
+            measured = "none" if b["measured_blowup_dt"] == float("inf") else f"{b['measured_blowup_dt']:.4g}"
+            rows.append(row + ["none", "none", measured, ""])
             continue
         ratio = b["predicted_dt_spectral"] / b["measured_blowup_dt"]
-        table.add_row(f"{b['stiffness']:g}", b["method"], f"{b['predicted_dt_spectral']:.4g}",
-                      f"{b['predicted_dt_gershgorin']:.4g}", f"{b['measured_blowup_dt']:.4g}", f"{ratio:.3f}")
+        rows.append(row + [f"{b['predicted_dt_spectral']:.4g}", f"{b['predicted_dt_gershgorin']:.4g}",
+                           f"{b['measured_blowup_dt']:.4g}", f"{ratio:.3f}"])
     unstable = [r for r in result.rows if r["method"] == "sdirk2" and not r["stable"]]
     console = _console()
-    console.print(table)
+    print_figures(console, "stability: predicted bound against measured blow-up",
+                  ["k [N/m]", "method", "bound\n[s]", "Gershgorin\n[s]", "measured\nblow-up [s]", "bound /\nmeasured"],
+                  rows, left=(1,))
     if unstable:
         console.print(f"sdirk2 failed {len(unstable)} probes (Newton did not converge or the energy balance broke)")
     console.print(f"written: {folder}/ (stability.csv, bounds.csv, stability.png)")

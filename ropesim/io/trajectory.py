@@ -204,3 +204,23 @@ class Trajectory:
             except (ValueError, OSError):
                 summary = {}
         return cls(t=t, x=x, v=v, scene=scene, summary=summary, folder=folder)
+
+    # Other tools and notebooks (ropesim.io.export, ropesim.render.notebook).
+    def export(self, to: str, out: str | Path | None = None):
+        """Write this run for other tools: ``to`` "vtk" (a ParaView series) or "csv" (see ropesim.io.export)."""
+        from .export import export
+        return export(self, to, out)
+
+    def animate(self, **options):
+        """An animation that plays inline in Jupyter (an MP4 in a <video>); options as `ropesim animate`'s."""
+        from ..render.notebook import inline_animation
+        return inline_animation(self, **options)
+
+    def _repr_html_(self) -> str:
+        from ..render.notebook import summary_html
+        return summary_html(self)
+
+    def __repr__(self) -> str:
+        return (f"Trajectory(scene={self.scene.name!r}, {self.summary.get('status', 'completed')}, "
+                f"{self.frames} frames, t = {float(self.t[0]):.6g} .. {float(self.t[-1]):.6g} s, "
+                f"{self.nodes} nodes, {self.x.shape[2]}-D, {'in memory' if self.folder is None else self.folder})")

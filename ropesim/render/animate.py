@@ -22,6 +22,7 @@ from .framing import Projection, figure_inches, followed_nodes, origin, projecti
 from ..io.atomic import atomic_output
 from .output import output_type
 from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
+from .style import with_picture_text
 from .timeline import animation_plan
 
 DPI = 100
@@ -88,11 +89,12 @@ def picture_title(fig, model: Model, proj: Projection) -> None:
              fontweight="bold")
     handles = legend_handles(model)
     if handles:
-        fig.legend(handles=handles, loc="upper left", bbox_to_anchor=(0, 1 - 17 / height), ncol=len(handles),
-                   frameon=False, fontsize=7, handletextpad=0.2, columnspacing=1.0, borderaxespad=0.0,
-                   borderpad=0.2)
+        fig.legend(handles=handles, loc="upper left", bbox_to_anchor=(4 / fig.bbox.width, 1 - 17 / height),
+                   ncol=len(handles), frameon=False, fontsize=7, handletextpad=0.2, columnspacing=1.0,
+                   borderaxespad=0.0, borderpad=0.2)
 
 
+@with_picture_text
 def animate(traj: Trajectory, out: str | Path, *, fps: float = 25.0, speed: float = 1.0,
             start: float | None = None, end: float | None = None, follow: bool = False, view: str | None = None,
             size: int = 640, progress: bool = False, note: Callable[[str], None] | None = None) -> Animation:

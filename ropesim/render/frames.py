@@ -20,6 +20,7 @@ from .framing import figure_inches, fit_box, followed_nodes, origin, projection,
 from ..io.atomic import atomic_output
 from .output import output_type
 from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
+from .style import OUTSIDE_RIGHT, with_picture_text
 from .timeline import chosen_frames
 
 DPI = 100
@@ -30,6 +31,7 @@ MIN_WIDTH = 360       # [px] default pictures are at least this wide, so the tit
 TICK_ROOM = 50        # [px] per panel: its tick labels across
 TITLE_ROOM = 44       # [px] per panel row: its title and tick labels
 HEADER_ROOM = 40      # [px] the figure's title and legend
+LEGEND_ROOM = 90      # [px] an overlay's legend, beside its view
 FADE = (0.35, 1.0)    # colour-map position and opacity of the first and the last overlaid frame
 
 
@@ -49,6 +51,7 @@ def default_columns(frames: int, aspect: float) -> int:
     return math.ceil(frames / math.ceil(frames / most))
 
 
+@with_picture_text
 def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None = None, count: int | None = None,
                 overlay: bool = False, follow: bool = False, view: str | None = None, columns: int | None = None,
                 width: int | None = None) -> Sheet:
@@ -82,6 +85,8 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
     px_width = width or cols * int(TICK_ROOM + side * min(1.0, 1.0 / aspect))
     px_height = int(round(HEADER_ROOM + rows * ((px_width / cols - TICK_ROOM) * aspect + TITLE_ROOM)))
     px_width = max(px_width, MIN_WIDTH)  # wider only: the views keep their size, centred
+    if overlay and width is None:
+        px_width += LEGEND_ROOM
     fig = Figure(figsize=figure_inches(px_width, px_height, DPI), dpi=DPI, layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(rows, cols, sharex=True, sharey=True, squeeze=False).ravel()
@@ -129,4 +134,4 @@ def _overlay(ax, model, proj, frames, offsets, times) -> None:
         color = cmap(f)
         RopeArtist(ax, model, proj, alpha=float(f), color=color).show(x, offset)
         handles.append(Line2D([], [], color=color, alpha=float(f), label=f"t = {t:.2f} s"))
-    ax.legend(handles=handles, fontsize=7, loc="best", framealpha=0.8)
+    ax.legend(handles=handles, fontsize=7, **OUTSIDE_RIGHT)

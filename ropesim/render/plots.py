@@ -22,9 +22,10 @@ from ..io.trajectory import Trajectory
 from .framing import figure_inches, frame_blocks
 from ..io.atomic import atomic_output
 from .output import output_type
+from .style import OUTSIDE_RIGHT, with_picture_text
 
 DPI = 100
-WIDTH = 720          # [px]
+WIDTH = 860          # [px] the panels, and their legends beside them
 PANEL_HEIGHT = 250   # [px] per panel
 HEADER = 40          # [px] the title
 
@@ -64,7 +65,7 @@ def draw_energy(ax, traj: Trajectory, model: Model) -> None:
             ax.plot(traj.t, values, linewidth=1.1, label=name)
     ax.set_ylabel("energy [J]")
     ax.set_title("Mechanical energy (gravity: m g y, zero at y = 0)")
-    ax.legend(fontsize=7, ncol=len(terms), loc="best")
+    ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
 
 def draw_ledger(ax, traj: Trajectory, model: Model) -> None:
@@ -93,7 +94,7 @@ def draw_ledger(ax, traj: Trajectory, model: Model) -> None:
     ax.set_title(f"Energy ledger: largest residual {summary['max_residual_J']:.3g} J = "
                  f"{summary['relative_residual']:.2g} of the energy that "
                  f"{'flowed' if summary['relative_to'] == 'flows' else 'moved'}")
-    ax.legend(fontsize=7, ncol=3, loc="best")
+    ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
 
 def draw_stretch(ax, traj: Trajectory, model: Model) -> None:
@@ -122,7 +123,7 @@ def draw_towed(ax, traj: Trajectory, model: Model) -> None:
     ax.set_xlabel("distance along the rope from the held end (at rest) [m]")
     ax.set_ylabel("angle from vertical [deg]")
     ax.set_title(title)
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
 
 def draw_inclination(ax, traj: Trajectory, model: Model) -> None:
@@ -133,11 +134,11 @@ def draw_inclination(ax, traj: Trajectory, model: Model) -> None:
     figures = shooter_figures(model, traj.t, traj.x, traj.v)
     t_end, window = float(traj.t[-1]), figures["averaged_over_s"]
     ax.plot([t_end - window, t_end], [figures["mean_loop_inclination_deg"]] * 2, "--", color="black",
-            label=f"mean over the last {window:.3g} s: {figures['mean_loop_inclination_deg']:.1f} deg")
+            label=f"mean, last {window:.3g} s: {figures['mean_loop_inclination_deg']:.1f} deg")
     ax.axhline(0, color="0.6", linewidth=0.8)
     ax.set_ylabel("inclination [deg]")
     ax.set_title("Loop inclination: 0 = hanging below the thrower, 90 = straight out in front")
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
 
 @dataclass(frozen=True)
@@ -168,18 +169,14 @@ class Plot:
     size: tuple[int, int]  # (width, height) [px]
 
 
-def plot_run(traj: Trajectory, out: str | Path) -> Plot:
-    """Write the run's figures (every :data:`PANELS` entry that applies to its scene) to the PNG ``out``."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
+def run_figure(traj: Trajectory):
+    """The figure of :func:`plot_run` and the names of its panels (every :data:`PANELS` entry that applies)."""
     from matplotlib.figure import Figure
 
-    out = Path(out)
-    output_type(out, (".png",))
     model = build(traj.scene)
     panels = [p for p in PANELS if p.applies(model)]
     height = HEADER + PANEL_HEIGHT * len(panels)
     fig = Figure(figsize=figure_inches(WIDTH, height, DPI), dpi=DPI, layout="constrained")
-    FigureCanvasAgg(fig)
     axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
     for ax, panel in zip(axes, panels):
         panel.draw(ax, traj, model)
@@ -194,6 +191,19 @@ def plot_run(traj: Trajectory, out: str | Path) -> Plot:
         ax.yaxis.label.set_fontsize(8)
     title = traj.scene.name + (f": {traj.scene.description}" if traj.scene.description else "")
     fig.suptitle(title, x=0.01, ha="left", fontsize=10, fontweight="bold", wrap=True)
+    return fig, tuple(p.name for p in panels)
+
+
+@with_picture_text
+def plot_run(traj: Trajectory, out: str | Path) -> Plot:
+    """Write the run's figures (every :data:`PANELS` entry that applies to its scene) to the PNG ``out``."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    out = Path(out)
+    output_type(out, (".png",))
+    fig, panels = run_figure(traj)
+    FigureCanvasAgg(fig)
     with atomic_output(out) as tmp:
         fig.savefig(tmp, format="png", dpi=DPI)
-    return Plot(path=out, panels=tuple(p.name for p in panels), size=(WIDTH, height))
+    width, height = (round(v) for v in fig.bbox.size)
+    return Plot(path=out, panels=panels, size=(width, height))

@@ -141,12 +141,17 @@ class RopeArtist:
             self.shift.clear().translate(*offset)
 
 
+LEGEND_MARKER = 8.0  # [pt] the largest marker in a legend: a line of 7 pt text holds it (the end mass's disc
+                     # in the view may be larger)
+
+
 def legend_handles(model: Model) -> list[Line2D]:
     """Legend entries for the nodes drawn apart from the rope (none for a plain rope)."""
-    handles = [Line2D([], [], linestyle="none", label=label, **style) for label, _, style in special_nodes(model)]
+    entries = [(label, style) for label, _, style in special_nodes(model)]
     if model.scene.pinned is not None:
-        handles.append(Line2D([], [], linestyle="none", label="pinned node", **pinned_style()))
-    return handles
+        entries.append(("pinned node", pinned_style()))
+    return [Line2D([], [], linestyle="none", label=label,
+                   **{**style, "markersize": min(style["markersize"], LEGEND_MARKER)}) for label, style in entries]
 
 
 def style_axes(ax, proj: Projection, box: np.ndarray, follow: bool, fontsize: float = 8) -> None:

@@ -103,17 +103,20 @@ def parse_times(text: str, option: str = "--times") -> list[float]:
     return values
 
 
+DEFAULT_COUNT = 6
+
+
 def chosen_frames(t: np.ndarray, times: list[float] | None = None, count: int | None = None) -> np.ndarray:
-    """Saved-frame indices for a frame sheet: the frames nearest to ``times``, or ``count`` evenly spaced
-    frames from the first to the last (both included)."""
+    """Saved-frame indices for a frame sheet: the frames nearest to ``times``, or ``count`` (default 6) evenly
+    spaced frames from the first to the last (both included); a run with fewer saved frames shows them all."""
     t = np.asarray(t, dtype=float)
     if times is not None and count is not None:
         raise RenderError("--times and --count: give one or the other")
     if times is not None:
         return nearest_frames(t, [check_time(t, s, "--times") for s in times])
-    count = 6 if count is None else count
+    count = DEFAULT_COUNT if count is None else count
     if count < 1:
         raise RenderError(f"--count {count}: must be at least 1")
-    if count > len(t):
-        raise RenderError(f"--count {count}: the run saved only {len(t)} frames")
+    if count >= len(t):
+        return np.arange(len(t))
     return nearest_frames(t, np.linspace(t[0], t[-1], count))

@@ -31,9 +31,13 @@ class SceneError(ValueError):
 
 
 def load_scene(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> S.Scene:
-    """Load and validate a scene file, applying ``--set`` style ``KEY=VALUE`` overrides first."""
-    path = Path(path)
-    source = str(path)
+    """Load and validate a scene file, or a built-in scene by name ("helicopter_mass"; a file that exists
+    wins, see :mod:`ropesim.scene.builtin`), applying ``--set`` style ``KEY=VALUE`` overrides first."""
+    from .builtin import resolve
+
+    found = resolve(path)
+    path = found.path
+    source = found.label
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:

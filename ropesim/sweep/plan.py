@@ -104,12 +104,11 @@ def _list(text: str) -> list:
         return [parse_override(f"v={part}")[1] for part in text.split(",")]
 
 
-def _spec_kind(key: str) -> str | None:
-    """The schema kind ("int", "float", ...) of a dotted scene key, or None if it names no single key."""
+def key_spec(key: str) -> S.Spec | None:
+    """The schema's :class:`Spec` (kind, doc, unit) of a dotted scene key, or None if it names no single key."""
     parts = key.split(".")
     if len(parts) == 1:
-        spec = S.TOP_LEVEL_SCALARS.get(parts[0])
-        return spec.kind if spec else None
+        return S.TOP_LEVEL_SCALARS.get(parts[0])
     head, rest = parts[0], parts[1:]
     if head in S.ARRAYS_OF_TABLES:
         classes = [S.ARRAYS_OF_TABLES[head]]
@@ -125,8 +124,14 @@ def _spec_kind(key: str) -> str | None:
     for cls in classes:
         for f in fields(cls):
             if f.name == rest[0] and "spec" in f.metadata:
-                return f.metadata["spec"].kind
+                return f.metadata["spec"]
     return None
+
+
+def _spec_kind(key: str) -> str | None:
+    """The schema kind ("int", "float", ...) of a dotted scene key, or None if it names no single key."""
+    spec = key_spec(key)
+    return spec.kind if spec else None
 
 
 def toml_value(value) -> str:

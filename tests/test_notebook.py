@@ -1,0 +1,70 @@
+"""Notebook users: a Trajectory's HTML summary, an animation that plays inline, and docs/notebooks/*.ipynb
+executed from the first cell to the last (nbclient), so the quickstart cannot rot."""
+
+from __future__ import annotations
+
+import base64
+from pathlib import Path
+
+import imageio_ffmpeg
+import nbformat
+import pytest
+from nbclient import NotebookClient
+
+import ropesim
+from ropesim.render.notebook import InlineAnimation
+
+from conftest import ROOT
+
+NOTEBOOKS = sorted((ROOT / "docs" / "notebooks").glob("*.ipynb"))
+
+
+@pytest.fixture(scope="module")
+def traj(tmp_path_factory):
+    scene = ropesim.load_scene("helicopter_parachute", ["integrator.t_end=0.4"])
+    return ropesim.simulate(scene, tmp_path_factory.mktemp("nb") / "run")
+
+
+def test_the_html_summary_says_what_the_run_is(traj):
+    page = traj._repr_html_()
+    for fragment in ("helicopter_parachute", "completed", "41, t = 0 .. 0.4 s", "21 (open line, 2-D)",
+                     "symplectic_euler, dt = 0.001 s", "x and v (41, 21, 2)", str(traj.folder)):
+        assert fragment in page, fragment
+    assert repr(traj) == (f"Trajectory(scene='helicopter_parachute', completed, 41 frames, t = 0 .. 0.4 s, 21 nodes, "
+                          f"2-D, {traj.folder})")   # short, not every array
+    scene = ropesim.load_scene("helicopter_parachute", ["integrator.t_end=0.02", "name=<b>&"])
+    assert "&lt;b&gt;&amp;" in ropesim.simulate(scene)._repr_html_()   # escaped; in memory
+    assert "in memory" in ropesim.simulate(scene)._repr_html_()
+
+
+def test_animate_returns_a_video_that_plays_inline(traj, tmp_path):
+    anim = traj.animate(fps=20, size=200)
+    assert isinstance(anim, InlineAnimation) and anim.frames == 9   # t = 0, 0.05, ..., 0.4
+    assert repr(anim).startswith("InlineAnimation(frames=9, fps=20")
+    page = anim._repr_html_()
+    assert page.startswith("<video") and "controls" in page
+    data = base64.b64decode(page.split("base64,", 1)[1].split('"', 1)[0])
+    assert data == anim.mp4
+    saved = anim.save(tmp_path / "a.mp4")
+    assert imageio_ffmpeg.count_frames_and_secs(str(saved))[0] == 9
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.name for p in NOTEBOOKS])
+def test_the_notebooks_run_without_an_error_or_a_warning(path, tmp_path):
+    notebook = nbformat.read(path, as_version=4)
+    assert all(not cell.get("outputs") for cell in notebook.cells if cell.cell_type == "code"), \
+        f"{path.name} is stored with outputs: clear them"
+    NotebookClient(notebook, timeout=600, kernel_name="python3",
+                   resources={"metadata": {"path": str(tmp_path)}}).execute()
+    outputs = [o for cell in notebook.cells if cell.cell_type == "code" for o in cell.outputs]
+    assert not [o for o in outputs if o.output_type == "error"]
+    assert not [o for o in outputs if o.output_type == "stream" and o.name == "stderr"], \
+        [o.text for o in outputs if o.output_type == "stream"]
+    html = [o.data["text/html"] for o in outputs if "text/html" in o.get("data", {})]
+    if path.name == "quickstart.ipynb":
+        assert any("ropesim.Trajectory" in h and "helicopter_mass" in h for h in html)
+        assert any(h.startswith("<video") for h in html)
+
+
+def test_there_is_a_notebook():
+    assert [p.name for p in NOTEBOOKS] == ["quickstart.ipynb"]
