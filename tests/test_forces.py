@@ -51,7 +51,7 @@ def reference_energy(x, n, closed, k, l, k2, g, mass):
 def kernel_force(model, x_nd):
     acc = np.zeros((model.dim, model.nodes))
     x = np.ascontiguousarray(x_nd.T)
-    accelerations(x, np.zeros_like(x), acc, model.params)
+    accelerations(x, np.zeros_like(x), acc, model.params, 0.0)
     return (acc * model.mass).T  # (N, D) newtons
 
 
@@ -167,7 +167,8 @@ def single_node_acc(model, pos, vel):
     x = np.array(pos, dtype=float).reshape(2, 1)
     v = np.array(vel, dtype=float).reshape(2, 1)
     acc = np.zeros((2, 1))
-    inv_mass, flags, spring, bending, gravity, thrower, guides = model.params
+    p = model.params
+    inv_mass, gravity, thrower, guides = p.inv_mass, p.gravity, p.thrower, p.guides
     acc[1, 0] -= gravity[0]
     add_thrower(x, v, acc, inv_mass[:1], thrower, gravity[0])
     add_guides(x, v, acc, guides, thrower, True, gravity[0])

@@ -18,6 +18,7 @@ from ropesim.integrate.methods import METHODS
 from ropesim.integrate.splitting import kick_factors
 from ropesim.scene.loader import scene_from_toml
 from ropesim.integrate.grid import TimeGrid
+from ropesim.integrate.health import LEDGER_COLUMNS
 from ropesim.integrate.methods import make_integrator
 
 from conftest import SCENARIOS
@@ -127,7 +128,7 @@ def test_shooter_ledger_books_the_box_and_the_drag(tmp_path):
     assert ledger["box_work_J"] > 0 and ledger["drag_loss_J"] > 0 and ledger["held_work_J"] == 0
     assert ledger["relative_residual"] < 0.01
     flows, energy0 = read_flows(tmp_path / "run")
-    assert flows.shape == (traj.frames, 3) and (tmp_path / "run" / LEDGER).is_file()
+    assert flows.shape == (traj.frames, len(LEDGER_COLUMNS)) and (tmp_path / "run" / LEDGER).is_file()
     series = ledger_series(build(scene), traj.x, traj.v, flows, energy0)
     assert series["residual"][-1] == pytest.approx(ledger["residual_J"])
     assert np.all(np.diff(series["drag_loss"]) >= 0)  # drag only ever takes energy

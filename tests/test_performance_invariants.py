@@ -189,7 +189,7 @@ def test_vectorised_chain_springs_equal_the_pairwise_springs(dim, n, closed, see
     add_pair_springs(x, expected, inv_mass, 40.0, 0.3, 1, closed)
     expected[1] -= 9.81
     got = np.full((dim, n), np.nan)   # overwritten, not added to
-    set_chain_springs(x, got, inv_mass, 40.0, 0.3, closed, 9.81)
+    set_chain_springs(x, got, inv_mass, 40.0, 0.3, closed, 9.81, False)
     np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-10)
 
 

@@ -21,7 +21,7 @@ from ropesim.render.animate import FrameRenderer, animate
 from ropesim.render.frames import frame_sheet
 from ropesim.render.framing import projection
 from ropesim.render.plots import plot_run, run_figure
-from ropesim.sweep.core import Axis
+from ropesim.sweep.plan import Axis
 from ropesim.sweep.plot import figure_label, key_label, sweep_figure
 
 from conftest import SCENARIOS

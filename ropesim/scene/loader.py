@@ -237,8 +237,8 @@ def _resolve_rope(rope: S.Rope, source: str) -> S.Rope:
         for key in PER_NODE_KEYS:
             if getattr(rope, key) is None:
                 spec = {f.name: f.metadata["spec"] for f in fields(S.Rope)}[key]
-                fail(key, f"missing: {spec.doc}{_unit(spec)} (or give the rope in physical units: length, "
-                          f"segments, mass_per_length and EA)")
+                fail(key, f"missing: {spec.doc}{_unit(spec)}; or give the rope in physical units (length, "
+                          f"segments, mass_per_length, EA)")
         return replace(rope, compression=True if rope.compression is None else rope.compression)
     for key in ("length", "EA"):
         if getattr(rope, key) is None:

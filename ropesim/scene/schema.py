@@ -64,14 +64,14 @@ class Rope:
     ``diameter`` (either form) is what fluid drag, buoyancy and added mass act on.
     """
 
-    nodes: int | None = spec("int", "number of point masses N (physical form: segments + 1 on a line, segments "
-                                    "on a loop)", default=None, required=False, low=2, high=1_000_000)
-    segment_length: float | None = spec("float", "rest length l of each segment", "m", default=None, required=False,
+    nodes: int | None = spec("int", "number of point masses N", default=None, required=False, low=2,
+                             high=1_000_000)
+    segment_length: float | None = spec("float", "rest length l of each spring", "m", default=None, required=False,
                                         low=0, open_low=True)
-    stiffness: float | None = spec("float", "spring constant k of each segment (physical form: EA / l)", "N/m",
-                                   default=None, required=False, low=0, open_low=True)
-    mass: float | None = spec("float", "mass m of each node (physical form: mass_per_length l; an open line's "
-                                       "ends carry half)", "kg", default=None, required=False, low=0, open_low=True)
+    stiffness: float | None = spec("float", "spring constant k between neighbours", "N/m", default=None,
+                                   required=False, low=0, open_low=True)
+    mass: float | None = spec("float", "mass m of each node", "kg", default=None, required=False, low=0,
+                              open_low=True)
     closed: bool = spec("bool", "true for a closed loop (the last node joins the first)", default=False)
     length: float | None = spec("float", "unstretched length of the whole rope (physical form)", "m", default=None,
                                 required=False, low=0, open_low=True)
