@@ -162,7 +162,11 @@ def simulate(scene: Scene, folder: str | Path | None = None, progress: bool = Fa
     model = build(scene)
     grid = TimeGrid.of(scene)
     folder = Path(folder) if folder is not None else None
-    store = FrameStore(grid.frames, model.nodes, model.dim, folder)
+    from .model.tension import frame_arrays, segment_count
+
+    segments = (segment_count(model),)
+    store = FrameStore(grid.frames, model.nodes, model.dim, folder, derive=lambda x, v: frame_arrays(model, x, v),
+                       shapes={"tension": segments, "strain": segments})
     try:
         if folder is not None:
             write_text_atomic(folder / SCENE, scene_to_toml(scene))
@@ -175,7 +179,8 @@ def simulate(scene: Scene, folder: str | Path | None = None, progress: bool = Fa
             store.finish()
             write_json_atomic(folder / SUMMARY, summary)
             return Trajectory.open(folder)
-        return Trajectory(t=arrays["t"], x=arrays["x"], v=arrays["v"], scene=scene, summary=summary)
+        return Trajectory(t=arrays["t"], x=arrays["x"], v=arrays["v"], scene=scene, summary=summary,
+                          tension=arrays["tension"], strain=arrays["strain"])
     finally:
         store.discard()
 

@@ -23,6 +23,7 @@ from .atomic import atomic_output
 
 TRAJECTORY, SCENE, SUMMARY = "trajectory.npz", "scene.toml", "summary.json"
 ARRAYS = ("t", "x", "v")
+DERIVED = ("tension", "strain")   # per frame and segment, derived from x and v as they are stored
 
 
 class RunFolderError(ValueError):
@@ -96,24 +97,31 @@ def _memmap_npz(path: Path) -> dict[str, np.ndarray]:
 
 
 class FrameStore:
-    """Where a run's saved frames go: memory for :func:`ropesim.simulate`, disk for a run folder."""
+    """Where a run's saved frames go: memory for :func:`ropesim.simulate`, disk for a run folder.
 
-    def __init__(self, n_frames: int, nodes: int, dim: int, folder: Path | None = None):
+    With ``derive`` (a function of frames x, v (k, N, D) returning named (k, ...) arrays, and ``shapes`` their
+    per-frame shapes) each appended chunk also stores what it derives, the segments' tension and strain.
+    """
+
+    def __init__(self, n_frames: int, nodes: int, dim: int, folder: Path | None = None, derive=None,
+                 shapes: dict[str, tuple] | None = None):
         self.count = 0
         self.folder = folder
-        shape = (n_frames, nodes, dim)
+        self.derive = derive
+        self.names = ARRAYS + tuple(shapes or {})
+        shape = {"t": (n_frames,), "x": (n_frames, nodes, dim), "v": (n_frames, nodes, dim),
+                 **{name: (n_frames, *s) for name, s in (shapes or {}).items()}}
         if folder is None:
             self._tmp = None
-            self.t = np.zeros(n_frames)
-            self.x = np.zeros(shape)
-            self.v = np.zeros(shape)
+            for name in self.names:
+                setattr(self, name, np.zeros(shape[name]))
         else:
             folder.mkdir(parents=True, exist_ok=True)
             self._tmp = Path(tempfile.mkdtemp(prefix=".frames-", dir=folder))
             open_mm = np.lib.format.open_memmap
-            self.t = open_mm(self._tmp / "t.npy", mode="w+", dtype=np.float64, shape=(n_frames,))
-            self.x = open_mm(self._tmp / "x.npy", mode="w+", dtype=np.float64, shape=shape)
-            self.v = open_mm(self._tmp / "v.npy", mode="w+", dtype=np.float64, shape=shape)
+            for name in self.names:
+                setattr(self, name, open_mm(self._tmp / f"{name}.npy", mode="w+", dtype=np.float64,
+                                            shape=shape[name]))
 
     def append(self, t: np.ndarray, x_dn: np.ndarray, v_dn: np.ndarray) -> None:
         """Append frames given in kernel layout (F, D, N)."""
@@ -124,10 +132,13 @@ class FrameStore:
         self.t[self.count:end] = t
         self.x[self.count:end] = np.swapaxes(x_dn, 1, 2)
         self.v[self.count:end] = np.swapaxes(v_dn, 1, 2)
+        if self.derive is not None:
+            for name, values in self.derive(self.x[self.count:end], self.v[self.count:end]).items():
+                getattr(self, name)[self.count:end] = values
         self.count = end
 
     def arrays(self) -> dict[str, np.ndarray]:
-        return {"t": self.t[:self.count], "x": self.x[:self.count], "v": self.v[:self.count]}
+        return {name: getattr(self, name)[:self.count] for name in self.names}
 
     def finish(self) -> None:
         """Write ``trajectory.npz`` (frames so far) atomically and drop the streaming files."""
@@ -140,7 +151,7 @@ class FrameStore:
 
     def discard(self) -> None:
         if self._tmp is not None:
-            for name in ARRAYS:
+            for name in self.names:
                 arr = getattr(self, name)
                 if isinstance(arr, np.memmap):
                     arr._mmap.close()
@@ -150,7 +161,9 @@ class FrameStore:
 
 @dataclass
 class Trajectory:
-    """Saved frames of one run: ``t`` (F,) [s], ``x`` and ``v`` (F, N, D) [m, m/s], with its scene and summary.
+    """Saved frames of one run: ``t`` (F,) [s], ``x`` and ``v`` (F, N, D) [m, m/s], each segment's ``tension``
+    [N] and ``strain`` (F, S), with its scene and summary (``tension`` and ``strain`` are None for a run
+    folder written before ropesim stored them).
 
     From :func:`ropesim.simulate` the arrays are in memory; from :meth:`open` they are memory-mapped.
     """
@@ -161,6 +174,8 @@ class Trajectory:
     scene: object
     summary: dict = field(default_factory=dict)
     folder: Path | None = None
+    tension: np.ndarray | None = None
+    strain: np.ndarray | None = None
 
     @property
     def frames(self) -> int:
@@ -197,13 +212,19 @@ class Trajectory:
         if t.ndim != 1 or x.shape != (len(t), n, d) or v.shape != x.shape or len(t) == 0:
             raise RunFolderError(f"{folder / TRAJECTORY}: arrays do not match the scene: t {t.shape}, "
                                  f"x {x.shape}, v {v.shape}, expected (F,), (F, {n}, {d})")
+        segments = n if scene.rope.closed else n - 1
+        derived = {name: arrays.get(name) for name in DERIVED}
+        for name, values in derived.items():
+            if values is not None and values.shape != (len(t), segments):
+                raise RunFolderError(f"{folder / TRAJECTORY}: {name} has shape {values.shape}, expected "
+                                     f"({len(t)}, {segments})")
         summary = {}
         if (folder / SUMMARY).is_file():
             try:
                 summary = json.loads((folder / SUMMARY).read_text(encoding="utf-8"))
             except (ValueError, OSError):
                 summary = {}
-        return cls(t=t, x=x, v=v, scene=scene, summary=summary, folder=folder)
+        return cls(t=t, x=x, v=v, scene=scene, summary=summary, folder=folder, **derived)
 
     # Other tools and notebooks (ropesim.io.export, ropesim.render.notebook).
     def export(self, to: str, out: str | Path | None = None):
