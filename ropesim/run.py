@@ -173,7 +173,7 @@ def simulate(scene: Scene, folder: str | Path | None = None, progress: bool = Fa
         with _progress(progress, scene) as on_progress:
             outcome = integrate(model, store, on_progress)
         arrays = store.arrays()
-        summary = summarize(model, outcome, arrays["t"], arrays["x"], arrays["v"])
+        summary = summarize(model, outcome, arrays["t"], arrays["x"], arrays["v"], arrays["tension"])
         if folder is not None:
             write_ledger(folder, arrays["t"], outcome.ledger, outcome.energy0)
             store.finish()

@@ -10,6 +10,7 @@ from ..model.forces.springs import pair_spring_stretch
 from ..model.energy import energy_terms
 from .ledger import ledger_series, ledger_summary
 from .stability import predicted_dt
+from .tension import tension_figures
 from .towed import towed_end, towed_figures
 
 FRAME_BLOCK = 256  # frames per block when scanning a (possibly memory-mapped) trajectory
@@ -35,8 +36,10 @@ def largest_stretch(model: Model, x: np.ndarray) -> tuple[float, float]:
     return best, where
 
 
-def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> dict:
-    """Everything a user wants to know about a finished (or stopped) run, as JSON-ready values."""
+def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray,
+              tension: np.ndarray | None = None) -> dict:
+    """Everything a user wants to know about a finished (or stopped) run, as JSON-ready values; with the frames'
+    ``tension`` (F, S) also the tension at both ends and the largest (see :mod:`ropesim.analysis.tension`)."""
     scene = model.scene
     grid = outcome.grid
     node_steps = outcome.steps * model.nodes
@@ -68,6 +71,8 @@ def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray
             summary.update(_physics_figures(model, t, x, v))
             summary["energy_ledger"] = ledger_summary(ledger_series(model, x, v, outcome.ledger, outcome.energy0),
                                                       outcome.energy0)
+            if tension is not None and len(tension):
+                summary["tension"] = tension_figures(t, tension)
     return summary
 
 

@@ -83,12 +83,20 @@ def print_summary(summary: dict, folder: Path) -> None:
         rows.append(("loop inclination", f"{shooter['loop_inclination_deg']:.1f} deg from vertical at t_end "
                                          f"(mean {shooter['mean_loop_inclination_deg']:.1f} deg over the last "
                                          f"{shooter['averaged_over_s']:.3g} s)"))
+    tension = summary.get("tension")
+    if tension:
+        rows.append(("tension", f"{tension['start_N']:.4g} N at node 0's end, {tension['end_N']:.4g} N at the "
+                                f"other at t_end; largest {tension['max_N']:.4g} N (segment {tension['max_segment']}, "
+                                f"t = {tension['max_t_s']:.3g} s)"))
     ledger = summary.get("energy_ledger")
     if ledger:
         flows = [f"{what} {ledger[key]:.4g} J" for what, key in (("drag took", "drag_loss_J"),
                                                                   ("held nodes gave", "held_work_J"),
-                                                                  ("thrower and guides gave", "box_work_J"))
-                 if ledger[key] != 0.0]
+                                                                  ("thrower and guides gave", "box_work_J"),
+                                                                  ("the fluid gave", "fluid_work_J"),
+                                                                  ("axial damping gave", "internal_work_J"),
+                                                                  ("the seabed gave", "seabed_work_J"))
+                 if ledger.get(key, 0.0) != 0.0]
         rows.append(("energy ledger", f"{', '.join(flows) or 'no energy flowed in or out'}; balance off by at "
                                       f"most {ledger['max_residual_J']:.3g} J ({ledger['relative_residual']:.2g} "
                                       f"of the energy that "

@@ -84,9 +84,12 @@ def draw_ledger(ax, traj: Trajectory, model: Model) -> None:
     t = traj.t[:n]
     ax.plot(t, series["total"] - energy0, color="black", linewidth=1.6, label="E(t) - E(0)")
     ax.plot(t, series["held_work"], linewidth=1.1, label="work by held nodes")
-    if np.any(series["box_work"]):
-        ax.plot(t, series["box_work"], linewidth=1.1, label="work by thrower and guides")
-    ax.plot(t, -series["drag_loss"], linewidth=1.1, label="- loss to drag")
+    for name, label in (("box_work", "work by thrower and guides"), ("fluid_work", "work by the fluid"),
+                        ("internal_work", "work by axial damping"), ("seabed_work", "work by the seabed")):
+        if np.any(series[name]):
+            ax.plot(t, series[name], linewidth=1.1, label=label)
+    if np.any(series["drag_loss"]):
+        ax.plot(t, -series["drag_loss"], linewidth=1.1, label="- loss to drag")
     ax.plot(t, series["residual"], color="#d62728", linewidth=1.4, label="residual (integration error)")
     ax.axhline(0, color="0.6", linewidth=0.8)
     summary = ledger_summary(series, energy0)
@@ -141,6 +144,36 @@ def draw_inclination(ax, traj: Trajectory, model: Model) -> None:
     ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
 
+def draw_end_tensions(ax, traj: Trajectory, model: Model) -> None:
+    """The tension in the rope's first and last segments over time."""
+    tension = traj.tension
+    ax.plot(traj.t, np.asarray(tension[:, 0]), linewidth=1.1, label="segment 0 (at node 0)")
+    if tension.shape[1] > 1:
+        ax.plot(traj.t, np.asarray(tension[:, -1]), linewidth=1.1, label=f"segment {tension.shape[1] - 1} (the other end)")
+    ax.axhline(0, color="0.6", linewidth=0.8)
+    ax.set_ylabel("tension [N]")
+    ax.set_title("Tension at the rope's ends")
+    ax.legend(fontsize=7, **OUTSIDE_RIGHT)
+
+
+def draw_tension_profile(ax, traj: Trajectory, model: Model) -> None:
+    """Tension along the rope at the last frame, and its range over the run."""
+    tension = traj.tension
+    i = last_finite_frame(traj)
+    along = (np.arange(tension.shape[1]) + 0.5) * model.scene.rope.segment_length
+    low, high = np.full(tension.shape[1], np.inf), np.full(tension.shape[1], -np.inf)
+    for s in range(0, len(traj.t), 4096):
+        block = np.asarray(tension[s:s + 4096])
+        low, high = np.minimum(low, np.nanmin(block, axis=0)), np.maximum(high, np.nanmax(block, axis=0))
+    ax.fill_between(along, low, high, color="#1f77b4", alpha=0.2, linewidth=0, label="range over the run")
+    ax.plot(along, np.asarray(tension[i]), "o-", markersize=3, color="#1f77b4", label=f"t = {traj.t[i]:.3g} s")
+    ax.axhline(0, color="0.6", linewidth=0.8)
+    ax.set_xlabel("distance along the rope from node 0 (at rest) [m]")
+    ax.set_ylabel("tension [N]")
+    ax.set_title("Tension along the rope")
+    ax.legend(fontsize=7, **OUTSIDE_RIGHT)
+
+
 @dataclass(frozen=True)
 class Panel:
     """One figure of the plot: its name, which scenes it is for, and how it is drawn."""
@@ -149,12 +182,15 @@ class Panel:
     applies: Callable[[Model], bool]
     draw: Callable  # (ax, traj, model) -> None
     time_axis: bool = True
+    needs_tension: bool = False   # only for run folders that store tension (ropesim 0.2 on)
 
 
 PANELS = (
     Panel("energy", lambda model: True, draw_energy),
     Panel("ledger", lambda model: True, draw_ledger),
     Panel("stretch", lambda model: True, draw_stretch),
+    Panel("end tensions", lambda model: True, draw_end_tensions, needs_tension=True),
+    Panel("tension profile", lambda model: True, draw_tension_profile, time_axis=False, needs_tension=True),
     Panel("towed", lambda model: towed_end(model.scene) is not None, draw_towed, time_axis=False),
     Panel("shooter", lambda model: model.scene.thrower is not None and model.scene.rope.closed, draw_inclination),
 )
@@ -174,7 +210,7 @@ def run_figure(traj: Trajectory):
     from matplotlib.figure import Figure
 
     model = build(traj.scene)
-    panels = [p for p in PANELS if p.applies(model)]
+    panels = [p for p in PANELS if p.applies(model) and (traj.tension is not None or not p.needs_tension)]
     height = HEADER + PANEL_HEIGHT * len(panels)
     fig = Figure(figsize=figure_inches(WIDTH, height, DPI), dpi=DPI, layout="constrained")
     axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
