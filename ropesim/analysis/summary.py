@@ -72,7 +72,7 @@ def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray
             summary["energy_ledger"] = ledger_summary(ledger_series(model, x, v, outcome.ledger, outcome.energy0),
                                                       outcome.energy0)
             if tension is not None and len(tension):
-                summary["tension"] = tension_figures(t, tension)
+                summary["tension"] = tension_figures(t, tension, block_frames(tension[0].nbytes))
     return summary
 
 

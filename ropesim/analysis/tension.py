@@ -9,20 +9,18 @@ from __future__ import annotations
 
 import numpy as np
 
-BLOCK_FRAMES = 4096
-
-
-def tension_figures(t: np.ndarray, tension: np.ndarray) -> dict:
-    """{start_N, end_N (at the last frame), start/end min and max over the run, max_N, max_segment, max_t_s}."""
+def tension_figures(t: np.ndarray, tension: np.ndarray, block: int) -> dict:
+    """{start_N, end_N (at the last frame), start/end min and max over the run, max_N, max_segment, max_t_s},
+    reading ``block`` frames at a time."""
     t = np.asarray(t)
     best, where, when = -np.inf, 0, 0
     start_range, end_range = [np.inf, -np.inf], [np.inf, -np.inf]
-    for s in range(0, len(t), BLOCK_FRAMES):
-        block = np.asarray(tension[s:s + BLOCK_FRAMES])
-        k, j = np.unravel_index(int(np.nanargmax(block)), block.shape)
-        if block[k, j] > best:
-            best, where, when = float(block[k, j]), int(j), s + int(k)
-        for column, bounds in ((block[:, 0], start_range), (block[:, -1], end_range)):
+    for s in range(0, len(t), block):
+        block_values = np.asarray(tension[s:s + block])
+        k, j = np.unravel_index(int(np.nanargmax(block_values)), block_values.shape)
+        if block_values[k, j] > best:
+            best, where, when = float(block_values[k, j]), int(j), s + int(k)
+        for column, bounds in ((block_values[:, 0], start_range), (block_values[:, -1], end_range)):
             bounds[0] = min(bounds[0], float(np.nanmin(column)))
             bounds[1] = max(bounds[1], float(np.nanmax(column)))
     last = np.asarray(tension[-1])

@@ -14,6 +14,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..analysis.summary import block_frames
 from ..model.energy import energy_terms
 from ..analysis.towed import exact_steady_state, segment_angles, shape_verdict, towed_end
 from ..model.build import Model, build
@@ -162,8 +163,9 @@ def draw_tension_profile(ax, traj: Trajectory, model: Model) -> None:
     i = last_finite_frame(traj)
     along = (np.arange(tension.shape[1]) + 0.5) * model.scene.rope.segment_length
     low, high = np.full(tension.shape[1], np.inf), np.full(tension.shape[1], -np.inf)
-    for s in range(0, len(traj.t), 4096):
-        block = np.asarray(tension[s:s + 4096])
+    step = block_frames(tension[0].nbytes)
+    for s in range(0, len(traj.t), step):
+        block = np.asarray(tension[s:s + step])
         low, high = np.minimum(low, np.nanmin(block, axis=0)), np.maximum(high, np.nanmax(block, axis=0))
     ax.fill_between(along, low, high, color="#1f77b4", alpha=0.2, linewidth=0, label="range over the run")
     ax.plot(along, np.asarray(tension[i]), "o-", markersize=3, color="#1f77b4", label=f"t = {traj.t[i]:.3g} s")
