@@ -67,14 +67,22 @@ def explicit_damping(model: Model) -> float:
     return max((term.damping(model) for term in declared_terms(model.scene)), default=0.0)
 
 
+def inertial_mass(model: Model) -> np.ndarray:
+    """Each node's mass [kg] as its stiffest mode sees it: its own, plus the smaller of its normal and
+    tangential added mass (the direction in which the fluid adds least inertia oscillates fastest)."""
+    added = model.params.added_mass
+    return model.mass + added.min(axis=0) if added.size else model.mass
+
+
 def gershgorin_frequency(model: Model) -> float:
     """Gershgorin bound [rad/s] on omega_max (see the module doc); 0 when no node is free."""
     free = ~model.held
     if not free.any():
         return 0.0
     i, j, k, diag = _laplacian_rows(model)
-    inv_sqrt_m = 1.0 / np.sqrt(model.mass)
-    row = diag / model.mass
+    mass = inertial_mass(model)
+    inv_sqrt_m = 1.0 / np.sqrt(mass)
+    row = diag / mass
     coupling = k * inv_sqrt_m[i] * inv_sqrt_m[j]
     np.add.at(row, i, coupling)
     np.add.at(row, j, coupling)
@@ -92,7 +100,7 @@ def spectral_frequency(model: Model) -> float:
     lap = np.diag(diag)
     np.add.at(lap, (i, j), -k)
     np.add.at(lap, (j, i), -k)
-    inv_sqrt_m = 1.0 / np.sqrt(model.mass)
+    inv_sqrt_m = 1.0 / np.sqrt(inertial_mass(model))
     sym = lap * inv_sqrt_m[:, None] * inv_sqrt_m[None, :]
     sym = sym[np.ix_(free, free)]
     top = float(np.linalg.eigvalsh(sym)[-1])
@@ -108,21 +116,32 @@ def drag_rates(model: Model) -> tuple[float, float]:
     return float(rate.min()), float(rate.max())
 
 
+RK4_REAL_LIMIT = 2.785293563405282   # RK4 is stable on x' = -lambda x while lambda h <= this (the real axis)
+
+
 def predicted_dt(model: Model, method: str, omega: float | None = None) -> float:
     """Largest stable time step [s] for ``method`` on this scene (inf for the stiff integrator).
 
     Uses the spectral bound on omega_max unless ``omega`` is given, and the worst of the scene's smallest and
-    largest drag rates and of no and the largest explicit damping.
+    largest drag rates and of no and the largest explicit damping (every term's ``damping`` hook: the
+    thrower's and guides', the fluid drag's at the run's speed scale, the axial damping's). With forces that
+    depend on velocity beyond the thrower's and guides', a splitting scheme's kicks are RK4 sub-stages
+    (:mod:`ropesim.integrate.velocity_kick`): they must also resolve the fastest damping, drag included,
+    (damping + b / m) |c| dt <= 2.785 for the largest kick coefficient |c|.
     """
     scheme = get_method(method)
     omega = spectral_frequency(model) if omega is None else omega
     low, high = drag_rates(model)
     damping = explicit_damping(model)
-    if scheme.exact_contact_kicks and model.smooth_contacts:
+    velocity_kick = model.velocity_terms and scheme.kick_span > 0
+    if scheme.exact_contact_kicks and model.smooth_contacts and not velocity_kick:
         high, damping = high + damping, 0.0  # the contacts' damping is integrated exactly, like drag
     # Damping can widen or narrow a method's interval, and the fastest mode may sit on lightly or heavily
     # damped nodes: take the worst of the extremes.
-    return min(stable_step(scheme, omega, f, d) for f in {0.0, damping} for d in {low, high})
+    bound = min(stable_step(scheme, omega, f, d) for f in {0.0, damping} for d in {low, high})
+    if velocity_kick and damping + high > 0:
+        bound = min(bound, RK4_REAL_LIMIT / ((damping + high) * scheme.kick_span))
+    return bound
 
 
 @dataclass(frozen=True)

@@ -107,6 +107,12 @@ class Method:
         """True when a step contains a kick backwards in time (it amplifies by drag; see stable_step)."""
         return False
 
+    @property
+    def kick_span(self) -> float:
+        """The largest |kick coefficient| of a splitting scheme (its longest velocity kick, in steps); 0 for a
+        method without kicks."""
+        return 0.0
+
     def amplification(self, h: float, omega: float, gamma_force: float = 0.0, gamma_drag: float = 0.0):
         """One step's 2x2 map of (x, v) for x'' = -omega^2 x - gamma_force x' - gamma_drag x'."""
         raise NotImplementedError

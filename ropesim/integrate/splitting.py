@@ -70,6 +70,10 @@ class SplittingScheme(Method):
     def backward_kicks(self) -> bool:
         return min(self.kick) < 0.0
 
+    @property
+    def kick_span(self) -> float:
+        return max(abs(c) for c in self.kick)
+
     def amplification(self, h: float, omega: float, gamma_force: float = 0.0, gamma_drag: float = 0.0):
         """One step's 2x2 map of (x, v) for x'' = -omega^2 x - gamma_force x' - gamma_drag x'.
 
