@@ -412,3 +412,27 @@ def test_undeclared_fluid_terms_leave_the_ledger_columns_at_zero():
     ledger = traj.summary["energy_ledger"]
     assert ledger["fluid_work_J"] == ledger["internal_work_J"] == ledger["seabed_work_J"] == 0.0
     assert FLUID == 3 and INTERNAL == 4   # the columns' places in ledger.npz and in saved frames
+
+
+# ------------------------------------------------------------------------------------- built-in scenes
+
+
+def test_helicopter_crosswind_settles_on_the_towed_line_turned_into_the_relative_wind():
+    """The sling trails in the vertical plane through the relative wind (20, 0, -5) m/s, turned 14.04 degrees
+    from the track (references.towed_cable.crosswind_plane), with the 2-D steady state of steady_state_march in
+    that plane: top tension, the hook's position and azimuth within 1e-3 after 300 s (the swing decayed)."""
+    from references.towed_cable import crosswind_plane
+
+    speed, azimuth = crosswind_plane(20.0, 5.0)
+    reference = steady_state_march(TowedLine.uniform(20.0, 40, mu=0.13, d=0.016, EA=5e6, rho=1.225, g=9.81,
+                                                     cd_n=1.2, cd_t=0.015, u=(speed, 0.0), end_mass=25.0,
+                                                     end_area=0.05, end_cd=1.0))
+    traj = ropesim.simulate(ropesim.load_scene("helicopter_crosswind", ["integrator.t_end=300", "integrator.dt=0.01",
+                                                                       "output.interval=300"]))
+    assert traj.summary["status"] == "completed"
+    hook = traj.x[-1][-1] - traj.x[-1][0]
+    trailing = math.hypot(hook[0], hook[2])
+    assert math.atan2(hook[2], -hook[0]) == pytest.approx(azimuth, rel=1e-3)
+    assert trailing == pytest.approx(-reference.x[-1][0], rel=1e-3)
+    assert hook[1] == pytest.approx(reference.x[-1][1], rel=1e-4)
+    assert traj.tension[-1][0] == pytest.approx(reference.T[0], rel=1e-3)

@@ -124,7 +124,13 @@ def print_check(scene: Scene, source: Path) -> None:
         table.add_row("description", scene.description)
     table.add_row("rope", f"{rope.nodes} nodes, {'closed loop' if rope.closed else 'open line'}, "
                           f"{scene.dimension}-D; l = {rope.segment_length:g} m, k = {rope.stiffness:g} N/m, "
-                          f"m = {rope.mass:g} kg")
+                          f"m = {rope.mass:g} kg" + (f" (the ends {rope.mass / 2:g} kg)" if rope.physical
+                                                       and not rope.closed else "")
+                          + ("" if rope.compression else "; slack in compression"))
+    if rope.physical:
+        table.add_row("physical form", f"{rope.length:g} m in {rope.segments} segments, {rope.mass_per_length:g} "
+                                       f"kg/m, EA = {rope.EA:g} N"
+                                       + (f", d = {rope.diameter:g} m" if rope.diameter else ""))
     table.add_row("initial", f"{scene.initial.shape}, velocity {list(scene.initial.velocity)} m/s")
     terms = ["springs"]
     if scene.bending:
@@ -137,6 +143,24 @@ def print_check(scene: Scene, source: Path) -> None:
         terms.append(f"thrower (v_max = {scene.thrower.v_max:g} m/s)")
     if scene.guides:
         terms.append(f"{len(scene.guides)} guide circle{'s' if len(scene.guides) > 1 else ''}")
+    if rope.axial_damping:
+        terms.append(f"axial damping (BA = {rope.axial_damping:g} N s)")
+    if scene.fluid:
+        terms.append(f"fluid (rho = {scene.fluid.density:g} kg/m^3)")
+    if scene.flow:
+        terms.append(f"{scene.flow.profile.replace('_', ' ')} flow"
+                     + (f", ramped over {scene.flow.ramp_time:g} s" if scene.flow.ramp_time else ""))
+    if scene.fluid_drag:
+        terms.append(f"fluid drag (Cd_n = {scene.fluid_drag.cd_normal:g}, Cd_t = {scene.fluid_drag.cd_tangential:g})")
+    if scene.viscous_drag:
+        terms.append(f"viscous drag (b_n = {scene.viscous_drag.b_normal:g}, b_t = {scene.viscous_drag.b_tangential:g} "
+                     f"N s/m^2)")
+    if scene.buoyancy:
+        terms.append("buoyancy")
+    if scene.added_mass:
+        terms.append(f"added mass (Ca_n = {scene.added_mass.ca_normal:g}, Ca_t = {scene.added_mass.ca_tangential:g})")
+    if scene.bodies:
+        terms.append(f"{len(scene.bodies)} bod{'ies' if len(scene.bodies) > 1 else 'y'}")
     table.add_row("force terms", ", ".join(terms))
     held = []
     if scene.pinned:

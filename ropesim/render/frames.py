@@ -82,11 +82,11 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
     cols = 1 if overlay else (columns or default_columns(len(indices), aspect))
     rows = math.ceil(len(indices) / cols) if not overlay else 1
     side = OVERLAY_SIDE if overlay else PANEL_SIDE
-    px_width = width or cols * int(TICK_ROOM + side * min(1.0, 1.0 / aspect))
-    px_height = int(round(HEADER_ROOM + rows * ((px_width / cols - TICK_ROOM) * aspect + TITLE_ROOM)))
+    beside = LEGEND_ROOM if overlay else 0   # an overlay's legend stands beside its view
+    px_width = width or cols * int(TICK_ROOM + side * min(1.0, 1.0 / aspect)) + beside
+    view_width = px_width / cols - TICK_ROOM - beside   # what is left for each view: it sets the height
+    px_height = int(round(HEADER_ROOM + rows * (view_width * aspect + TITLE_ROOM)))
     px_width = max(px_width, MIN_WIDTH)  # wider only: the views keep their size, centred
-    if overlay and width is None:
-        px_width += LEGEND_ROOM
     fig = Figure(figsize=figure_inches(px_width, px_height, DPI), dpi=DPI, layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(rows, cols, sharex=True, sharey=True, squeeze=False).ravel()

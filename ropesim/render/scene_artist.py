@@ -103,6 +103,14 @@ def special_nodes(model: Model) -> list[tuple[str, np.ndarray, dict]]:
             out.append((f"{name} {o.mass:g} kg", np.array([i]), heavy_style(o.mass / rope.mass)))
         if o.drag is not None and o.drag > base_drag:
             out.append((f"parachute, b = {o.drag:g} kg/s", np.array([i]), parachute_style()))
+    for body in scene.bodies:   # a body with mass is drawn as a heavy node, one with drag alone as a canopy
+        i = scene.node(body.node)
+        if body.mass > 0:
+            what = "body" if rope.closed or i not in (0, rope.nodes - 1) else "end body"
+            out.append((f"{what} {body.mass:g} kg" + (f", CdA {body.cd_area:g} m^2" if body.cd_area else ""),
+                        np.array([i]), heavy_style(model.mass[i] / rope.mass)))
+        elif body.cd_area > 0:
+            out.append((f"drag body, CdA {body.cd_area:g} m^2", np.array([i]), parachute_style()))
     driven = sorted({scene.node(i) for d in scene.driven for i in d.nodes})
     if driven:
         speeds = ", ".join(f"{np.linalg.norm(d.velocity):g}" for d in scene.driven)
