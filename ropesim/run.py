@@ -162,11 +162,10 @@ def simulate(scene: Scene, folder: str | Path | None = None, progress: bool = Fa
     model = build(scene)
     grid = TimeGrid.of(scene)
     folder = Path(folder) if folder is not None else None
-    from .model.tension import frame_arrays, segment_count
+    from .model.tension import frame_arrays, frame_shapes
 
-    segments = (segment_count(model),)
-    store = FrameStore(grid.frames, model.nodes, model.dim, folder, derive=lambda x, v: frame_arrays(model, x, v),
-                       shapes={"tension": segments, "strain": segments})
+    store = FrameStore(grid.frames, model.nodes, model.dim, folder,
+                       derive=lambda t, x, v: frame_arrays(model, t, x, v), shapes=frame_shapes(model))
     try:
         if folder is not None:
             write_text_atomic(folder / SCENE, scene_to_toml(scene))
@@ -180,7 +179,7 @@ def simulate(scene: Scene, folder: str | Path | None = None, progress: bool = Fa
             write_json_atomic(folder / SUMMARY, summary)
             return Trajectory.open(folder)
         return Trajectory(t=arrays["t"], x=arrays["x"], v=arrays["v"], scene=scene, summary=summary,
-                          tension=arrays["tension"], strain=arrays["strain"])
+                          tension=arrays["tension"], strain=arrays["strain"], support=arrays.get("support"))
     finally:
         store.discard()
 

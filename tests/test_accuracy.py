@@ -320,7 +320,7 @@ def test_banded_newton_solver_matches_a_dense_solve(n, dim, bending, closed, see
     """The stiff integrator's linear solver (banded Cholesky, Woodbury correction for a loop's wrap-around)
     solves a random positive definite rope matrix, with springs between neighbours and second neighbours, as
     a dense solve does, to round-off."""
-    from ropesim.integrate.banded import factor, solve, woodbury
+    from ropesim.model.banded import factor, solve, woodbury
     from ropesim.model.build import spring_count
     from ropesim.model.jacobian import Jacobian, add_pair, band_width
 

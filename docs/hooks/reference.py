@@ -36,6 +36,7 @@ KINDS = {
     "vector": "vector",
     "int_list": "node indices",
     "points": "list of vectors",
+    "rows": "table",
 }
 
 # What a key left out means when the schema's default is None ("work it out from the rest of the scene").
@@ -98,6 +99,7 @@ def allowed(spec) -> str:
         "vector": "`dimension` numbers",
         "int_list": "a list of indices, or one; −N to N−1",
         "points": "N vectors",
+        "rows": "rows of t and `dimension` numbers, t increasing",
         "str": "any",
         "int": "any integer",
         "float": "any number",

@@ -22,7 +22,7 @@ def towed_end(scene: Scene) -> int | None:
     """The held end of a towed rope (0 or N-1), or None if the scene is not one.
 
     A towed rope is an open line with exactly one held node, at one of its ends, and no bending, thrower,
-    guides or fluid terms but the linear [drag] (so the steady state above is exact).
+    guides, seabed, moving drive or fluid terms but the linear [drag] (so the steady state above is exact).
     """
     n = scene.rope.nodes
     held = [scene.node(i) for i in (scene.pinned.nodes if scene.pinned else ())]
@@ -30,8 +30,10 @@ def towed_end(scene: Scene) -> int | None:
         held += [scene.node(i) for i in drive.nodes]
     if scene.rope.closed or len(held) != 1 or held[0] not in (0, n - 1):
         return None
-    if scene.bending is not None or scene.thrower is not None or scene.guides:
+    if scene.bending is not None or scene.thrower is not None or scene.guides or scene.seabed is not None:
         return None
+    if any(drive.moving for drive in scene.driven):
+        return None   # the steady state needs a constant tow velocity
     if any(getattr(scene, part) is not None for part in ("flow", "fluid_drag", "viscous_drag", "buoyancy",
                                                           "added_mass")) or scene.bodies:
         return None   # the closed form below is for linear drag in still air; see tests/references/towed_cable.py

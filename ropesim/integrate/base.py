@@ -63,6 +63,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..model.motion import place_moving
 from .health import LEDGER_COLUMNS, initial_ledger, limits
 
 CHECK_EVERY = 64   # steps between blow-up checks: a blow-up is caught within this many steps
@@ -74,8 +75,10 @@ a frame every ``save_every`` steps and at the last, a health check every ``check
 Frames = namedtuple("Frames", ["t", "x", "v", "ledger"])
 """Frame buffers of one call: t (F,) [s], x and v (F, D, N) [m, m/s], the ledger's flows (F, 3) [J]."""
 
-Held = namedtuple("Held", ["idx", "x0", "v"])
-"""The held (pinned or driven) nodes: indices (H,), positions at t = 0 (D, H) [m], velocities (D, H) [m/s]."""
+Held = namedtuple("Held", ["idx", "x0", "v", "motion"])
+"""The held (pinned or driven) nodes: indices (H,), positions at t = 0 (D, H) [m], velocities (D, H) [m/s]
+(constant, or for a prescribed motion the current ones, kept up to date by the loops), and their
+:class:`~ropesim.model.motion.Motion`."""
 
 Advance = namedtuple("Advance", ["done", "written", "status", "node"])
 """What a call did: steps done, frames written, health status (:mod:`ropesim.integrate.health`), its node."""
@@ -171,9 +174,12 @@ class Integrator:
         self.x = model.x0.copy()
         self.v = model.v0.copy()
         self.step = 0
+        motion = model.motion._replace(accel=model.motion.accel.copy())
+        self.held = Held(model.held_idx, model.held_x0, model.held_v.copy(), motion)
+        if motion.moving:
+            place_moving(self.x, self.v, self.held, 0.0)   # a sinusoid starts with its own velocity
         self.ledger = initial_ledger(model, self.x, self.v)
         self.limits = limits(model)
-        self.held = Held(model.held_idx, model.held_x0, model.held_v)
 
     # -- what a family provides --------------------------------------------------------------------------
 

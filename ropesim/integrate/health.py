@@ -23,6 +23,7 @@ positive) and of the seabed W_seabed; then the initial mechanical energy E0 and 
 import numpy as np
 from numba import njit
 
+from ..model.motion import place_moving
 from ..model.terms import mechanical_energy
 
 OK, NON_FINITE, OVERSTRETCH, RUNAWAY_ENERGY, NEWTON_FAILED = 0, 1, 2, 3, 4
@@ -123,18 +124,36 @@ def save_frame(frame, t, x, v, ledger, frames_t, frames_x, frames_v, frames_w):
 
 
 @njit(cache=True, error_model="numpy")
-def held_power(acc, mass, held_idx, held_v):
+def held_power(acc, mass, held):
     """Power [W] of the held nodes' supports on the rope at one instant.
 
-    A held node does not accelerate, so its support pushes it with -m a (a without drag), moving at V.
+    A held node follows its prescribed motion, so its support pushes it with m (a_p - a), a the acceleration
+    the forces would give it (``acc``, without the linear drag) and a_p the prescribed one (zero for pins and
+    constant drives), while it moves at its velocity ``held.v``.
     """
+    held_idx, held_v, motion = held.idx, held.v, held.motion
     dim = acc.shape[0]
     p = 0.0
     for j in range(held_idx.shape[0]):
         i = held_idx[j]
         for d in range(dim):
             p -= mass[i] * acc[d, i] * held_v[d, j]
+    if motion.moving:
+        for j in range(held_idx.shape[0]):
+            i = held_idx[j]
+            for d in range(dim):
+                p += mass[i] * motion.accel[d, j] * held_v[d, j]
     return p
+
+
+@njit(cache=True, error_model="numpy")
+def place(x, v, held, t):
+    """Put every held node where it must be at time t: x0 + V t, or its prescribed motion (which also sets its
+    velocity in ``v``, see :mod:`ropesim.model.motion`)."""
+    if held.motion.moving:
+        place_moving(x, v, held, t)
+    else:
+        place_held(x, held.idx, held.x0, held.v, t)
 
 
 @njit(cache=True, error_model="numpy")

@@ -53,7 +53,7 @@ def applies(model, scheme) -> bool:
     flags = model.params.flags
     others = [f for f in range(N_FLAGS) if f != GRAVITY]
     return (model.dim == 2 and model.nodes >= 2 and not any(flags[f] for f in others)
-            and model.scene.rope.compression)
+            and model.scene.rope.compression and not model.motion.moving)
 
 
 def plain_bundle(model, decay: np.ndarray, gain: np.ndarray, travel: np.ndarray) -> Plain:

@@ -19,7 +19,7 @@ from numba import njit
 
 from ..model.terms import ADDED_MASS, accelerations, added_mass, any_applied, applied_accelerations
 from .base import Integrator, Method
-from .health import BOX, DRAG, FLUID, HELD, INTERNAL, OK, due, end_step, held_power, place_held, power
+from .health import BOX, DRAG, FLUID, HELD, INTERNAL, OK, SEABED, due, end_step, held_power, place, power
 
 
 @dataclass(frozen=True)
@@ -108,7 +108,7 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
     x, v, ledger = state
     a, b, c = tables
     xs, vs, kx, kv, acc, acc_box = scratch
-    held_idx, held_x0, held_v = held
+    held_idx, held_v = held.idx, held.v
     h = schedule.h
     dim, n = x.shape
     stages = b.shape[0]
@@ -129,11 +129,11 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
                             pv += w * kv[j, d, i]
                     xs[d, i] = px
                     vs[d, i] = pv
-            place_held(xs, held_idx, held_x0, held_v, t + c[st] * h)
+            place(xs, vs, held, t + c[st] * h)
             for j in range(held_idx.shape[0]):
                 for d in range(dim):
                     vs[d, held_idx[j]] = held_v[d, j]
-            fluid, internal = accelerations(xs, vs, acc, params, t + c[st] * h)
+            fluid, internal, seabed = accelerations(xs, vs, acc, params, t + c[st] * h)
             lost = 0.0
             for d in range(dim):
                 for i in range(n):
@@ -147,9 +147,10 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
                     kv[st, d, held_idx[j]] = 0.0
             wh = b[st] * h
             ledger[DRAG] += wh * lost
-            ledger[HELD] += wh * held_power(acc, mass, held_idx, held_v)
+            ledger[HELD] += wh * held_power(acc, mass, held)
             ledger[FLUID] += wh * fluid
             ledger[INTERNAL] += wh * internal
+            ledger[SEABED] += wh * seabed
             if has_box:
                 applied_accelerations(xs, vs, acc_box, params)
                 ledger[BOX] += wh * power(acc_box, vs, mass)
@@ -162,7 +163,7 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
                     dv += b[st] * kv[st, d, i]
                 x[d, i] += h * dx
                 v[d, i] += h * dv
-        place_held(x, held_idx, held_x0, held_v, (step + 1) * h)
+        place(x, v, held, (step + 1) * h)
         done = step + 1
         if not due(done, schedule):
             continue  # nothing due: skip the call, whose array arguments cost more than a small rope's step

@@ -13,7 +13,7 @@ solved by Newton's method. Its Jacobian, M (1 + beta gamma_drag) + beta^2 H + be
 stiffness, C_v their velocity damping, each term's blocks from its own module through the term list's
 :func:`~ropesim.model.terms.coupling_jacobian` and :func:`~ropesim.model.terms.node_jacobian`), couples each
 node only to its neighbours and second neighbours: a block banded matrix (:mod:`ropesim.model.jacobian`),
-factored by a banded Cholesky in O(N) per iteration (:mod:`ropesim.integrate.banded`). On a closed loop the
+factored by a banded Cholesky in O(N) per iteration (:mod:`ropesim.model.banded`). On a closed loop the
 wrap-around couples the first and last nodes; a Woodbury correction of rank w D (w = 1, or 2 with bending)
 handles it, still O(N). Negative (compressive) geometric stiffness is left out
 of the Jacobian so the matrix stays symmetric positive definite: Newton then converges a little more slowly
@@ -32,11 +32,11 @@ from numba import njit
 
 from ..model.jacobian import Jacobian, band_width
 from ..model.forces.added_mass import added_mass_times
-from ..model.terms import (ADDED_MASS, accelerations, added_mass, any_applied, applied_accelerations, coupling_jacobian,
-                           coupling_reach, node_jacobian)
-from .banded import factor, solve, woodbury
+from ..model.terms import (ADDED_MASS, accelerations, added_mass, any_applied, applied_accelerations, coupling_reach,
+                           newton_matrix)
+from ..model.banded import factor, solve, woodbury
 from .base import Integrator, Method
-from .health import BOX, DRAG, FLUID, HELD, INTERNAL, NEWTON_FAILED, OK, due, end_step, held_power, place_held, power
+from .health import BOX, DRAG, FLUID, HELD, INTERNAL, NEWTON_FAILED, OK, SEABED, due, end_step, held_power, place, power
 
 GAMMA = 1.0 - 1.0 / math.sqrt(2.0)
 NEWTON_TOL = 1e-11      # Newton stops when no free node's position changes by more than this times l
@@ -123,35 +123,13 @@ class SdirkFamily(Integrator):
 
 
 @njit(cache=True, error_model="numpy")
-def assemble(X, V, jac, beta, nodes, params, t):
-    """The Newton matrix M (1 + beta gamma) + beta^2 H + beta C_v into ``jac`` (see the module doc)."""
-    free, mass, drag = nodes
-    band, corner = jac.band, jac.corner
-    dim, n = X.shape
-    band[:] = 0.0
-    corner[:] = 0.0
-    coupling_jacobian(X, jac, beta, free, params)
-    for i in range(n):
-        if not free[i]:
-            for d in range(dim):
-                band[0, i * dim + d] = 1.0
-                for e in range(d + 1, dim):
-                    band[e - d, i * dim + d] = 0.0
-            continue
-        diag = mass[i] + beta * drag[i]
-        for d in range(dim):
-            band[0, i * dim + d] += diag
-    node_jacobian(X, V, band, beta, mass, free, params, t)
-
-
-@njit(cache=True, error_model="numpy")
 def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     """Newton solve of one stage: X = xh + beta V, V = vh + beta (a(X, V) - gamma V). Returns
     (iterations, node, fluid power [W], internal-damping power [W]): iterations < 0 when it failed, naming the
     node that moved most in the last one. With added mass the stage's equation is M (V - vh) = beta (F - b V),
     M = m I + A per node (:mod:`ropesim.model.forces.added_mass`)."""
     xh, vh, X, V, acc = stage.xh, stage.vh, stage.X, stage.V, stage.acc
-    held_idx, held_x0, held_v = held
+    held_idx, held_v = held.idx, held.v
     free, mass, drag = nodes
     band, rhs = newton.jac.band, newton.rhs
     dim, n = X.shape
@@ -159,7 +137,7 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     for d in range(dim):
         for i in range(n):
             X[d, i] = xh[d, i] + beta * vh[d, i]
-    place_held(X, held_idx, held_x0, held_v, t_stage)
+    place(X, V, held, t_stage)
     worst_node = -1
     inertial = params.flags[ADDED_MASS] != 0
     closed = params.spring[2] != 0.0
@@ -170,7 +148,7 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
         for j in range(held_idx.shape[0]):
             for d in range(dim):
                 V[d, held_idx[j]] = held_v[d, j]
-        fluid, internal = accelerations(X, V, acc, params, t_stage)
+        fluid, internal, seabed = accelerations(X, V, acc, params, t_stage)
         for i in range(n):
             for d in range(dim):
                 u = i * dim + d
@@ -187,9 +165,9 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
                 extra = added_mass_times(X, i, w0, w1, w2, params.added_mass, closed)
                 for d in range(dim):
                     rhs[i * dim + d] -= extra[d]
-        assemble(X, V, newton.jac, beta, nodes, params, t_stage)
+        newton_matrix(X, V, newton.jac, beta, nodes, params, t_stage)
         if not factor(band, newton.jac.corner, newton.cyclic, p, newton.wood):
-            return -1, 0, 0.0, 0.0
+            return -1, 0, 0.0, 0.0, 0.0
         solve(band, newton.jac.corner, newton.cyclic, p, rhs, newton.wood)
         worst = 0.0
         for i in range(n):
@@ -204,8 +182,8 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
                 for i in range(n):
                     if free[i]:
                         V[d, i] = (X[d, i] - xh[d, i]) / beta
-            return it + 1, -1, fluid, internal
-    return -1, worst_node, 0.0, 0.0
+            return it + 1, -1, fluid, internal, seabed
+    return -1, worst_node, 0.0, 0.0, 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -217,7 +195,6 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
     """
     x, v, ledger, stats = state
     xh, vh, X, V, acc, acc_box, tmp = stage
-    held_idx, held_x0, held_v = held
     free, mass, drag = nodes
     h = schedule.h
     dim, n = x.shape
@@ -233,7 +210,7 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
                 vh[d, i] = v[d, i]
         for k in range(2):
             t_stage = t + (GAMMA if k == 0 else 1.0) * h
-            its, node, fluid, internal = solve_stage(stage, newton, beta, t_stage, held, nodes, params)
+            its, node, fluid, internal, seabed = solve_stage(stage, newton, beta, t_stage, held, nodes, params)
             if its < 0:
                 return s, frame, NEWTON_FAILED, node
             stats[0] += its
@@ -243,7 +220,7 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
                 for i in range(n):
                     lost += drag[i] * V[d, i] * V[d, i]
             ledger[DRAG] += weight * lost
-            ledger[HELD] += weight * held_power(acc, mass, held_idx, held_v)
+            ledger[HELD] += weight * held_power(acc, mass, held)
             if params.flags[ADDED_MASS]:   # the fluid's inertial force, m a - F, at the stage
                 for d in range(dim):
                     for i in range(n):
@@ -251,6 +228,7 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
                 fluid += added_mass(X, V, tmp, params)
             ledger[FLUID] += weight * fluid
             ledger[INTERNAL] += weight * internal
+            ledger[SEABED] += weight * seabed
             if has_box:
                 applied_accelerations(X, V, acc_box, params)
                 ledger[BOX] += weight * power(acc_box, V, mass)
@@ -264,7 +242,7 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
             for i in range(n):
                 x[d, i] = X[d, i]
                 v[d, i] = V[d, i]
-        place_held(x, held_idx, held_x0, held_v, (step + 1) * h)
+        place(x, v, held, (step + 1) * h)
         done = step + 1
         if not due(done, schedule):
             continue  # nothing due: skip the call, whose array arguments cost more than a small rope's step

@@ -42,13 +42,13 @@ def velocity_kick(x, v, acc_x, tau, t, params, mass, gamma, held, scratch):
     position-only accelerations, ``gamma`` (N,) the linear drag rates b / m (0 at held nodes).
 
     Returns the energy [J] of each flow over the kick: (drag loss, held work, box work, fluid work, internal
-    work).
+    work, seabed work).
     """
     dim, n = x.shape
     slopes, y, a, a_box = scratch
-    held_idx, held_v = held.idx, held.v
+    held_idx, held_v, motion = held.idx, held.v, held.motion
     has_box = any_applied(params.flags)
-    drag = supports = box = fluid = internal = 0.0
+    drag = supports = box = fluid = internal = seabed = 0.0
     for s in range(4):
         c = RK4_A[s] * tau
         for d in range(dim):
@@ -57,12 +57,12 @@ def velocity_kick(x, v, acc_x, tau, t, params, mass, gamma, held, scratch):
         for d in range(dim):
             for i in range(n):
                 a[d, i] = acc_x[d, i]
-        p_fluid, p_internal = velocity_accelerations(x, y, a, params, t)
+        p_fluid, p_internal, p_seabed = velocity_accelerations(x, y, a, params, t)
         p_support = 0.0
         for j in range(held_idx.shape[0]):
             i = held_idx[j]
             for d in range(dim):
-                p_support -= mass[i] * a[d, i] * held_v[d, j]
+                p_support -= mass[i] * (a[d, i] - motion.accel[d, j]) * held_v[d, j]
         p_drag = 0.0
         for d in range(dim):
             for i in range(n):
@@ -87,8 +87,9 @@ def velocity_kick(x, v, acc_x, tau, t, params, mass, gamma, held, scratch):
         box += w * p_box
         fluid += w * p_fluid
         internal += w * p_internal
+        seabed += w * p_seabed
     for d in range(dim):
         for i in range(n):
             v[d, i] += tau * (RK4_B[0] * slopes[0, d, i] + RK4_B[1] * slopes[1, d, i] + RK4_B[2] * slopes[2, d, i]
                               + RK4_B[3] * slopes[3, d, i])
-    return drag, supports, box, fluid, internal
+    return drag, supports, box, fluid, internal, seabed

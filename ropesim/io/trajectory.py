@@ -23,7 +23,7 @@ from .atomic import atomic_output
 
 TRAJECTORY, SCENE, SUMMARY = "trajectory.npz", "scene.toml", "summary.json"
 ARRAYS = ("t", "x", "v")
-DERIVED = ("tension", "strain")   # per frame and segment, derived from x and v as they are stored
+DERIVED = ("tension", "strain", "support")   # per frame, derived from t, x and v as they are stored
 
 
 class RunFolderError(ValueError):
@@ -99,8 +99,9 @@ def _memmap_npz(path: Path) -> dict[str, np.ndarray]:
 class FrameStore:
     """Where a run's saved frames go: memory for :func:`ropesim.simulate`, disk for a run folder.
 
-    With ``derive`` (a function of frames x, v (k, N, D) returning named (k, ...) arrays, and ``shapes`` their
-    per-frame shapes) each appended chunk also stores what it derives, the segments' tension and strain.
+    With ``derive`` (a function of the frames' t (k,), x and v (k, N, D) returning named (k, ...) arrays, and
+    ``shapes`` their per-frame shapes) each appended chunk also stores what it derives: the segments' tension
+    and strain, the supports' forces (:mod:`ropesim.model.tension`).
     """
 
     def __init__(self, n_frames: int, nodes: int, dim: int, folder: Path | None = None, derive=None,
@@ -133,7 +134,8 @@ class FrameStore:
         self.x[self.count:end] = np.swapaxes(x_dn, 1, 2)
         self.v[self.count:end] = np.swapaxes(v_dn, 1, 2)
         if self.derive is not None:
-            for name, values in self.derive(self.x[self.count:end], self.v[self.count:end]).items():
+            for name, values in self.derive(self.t[self.count:end], self.x[self.count:end],
+                                            self.v[self.count:end]).items():
                 getattr(self, name)[self.count:end] = values
         self.count = end
 
@@ -162,8 +164,9 @@ class FrameStore:
 @dataclass
 class Trajectory:
     """Saved frames of one run: ``t`` (F,) [s], ``x`` and ``v`` (F, N, D) [m, m/s], each segment's ``tension``
-    [N] and ``strain`` (F, S), with its scene and summary (``tension`` and ``strain`` are None for a run
-    folder written before ropesim stored them).
+    [N] and ``strain`` (F, S), the force each support exerts on its held node, ``support`` (F, H, D) [N] (None
+    without held nodes), with its scene and summary (the derived arrays are None for a run folder written
+    before ropesim stored them).
 
     From :func:`ropesim.simulate` the arrays are in memory; from :meth:`open` they are memory-mapped.
     """
@@ -176,6 +179,7 @@ class Trajectory:
     folder: Path | None = None
     tension: np.ndarray | None = None
     strain: np.ndarray | None = None
+    support: np.ndarray | None = None
 
     @property
     def frames(self) -> int:
@@ -212,12 +216,11 @@ class Trajectory:
         if t.ndim != 1 or x.shape != (len(t), n, d) or v.shape != x.shape or len(t) == 0:
             raise RunFolderError(f"{folder / TRAJECTORY}: arrays do not match the scene: t {t.shape}, "
                                  f"x {x.shape}, v {v.shape}, expected (F,), (F, {n}, {d})")
-        segments = n if scene.rope.closed else n - 1
         derived = {name: arrays.get(name) for name in DERIVED}
         for name, values in derived.items():
-            if values is not None and values.shape != (len(t), segments):
-                raise RunFolderError(f"{folder / TRAJECTORY}: {name} has shape {values.shape}, expected "
-                                     f"({len(t)}, {segments})")
+            if values is not None and (values.ndim < 2 or values.shape[0] != len(t)):
+                raise RunFolderError(f"{folder / TRAJECTORY}: {name} has shape {values.shape}, not one row per "
+                                     f"frame ({len(t)})")
         summary = {}
         if (folder / SUMMARY).is_file():
             try:

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..scene import schema as S
 from ..scene.shapes import initial_positions
+from .motion import Motion, motion_of
 from .terms import Layout, ModelParams, has_applied, model_params, velocity_terms_on
 
 
@@ -35,6 +36,7 @@ class Model:
     held_x0: np.ndarray       # (D, H) their positions at t = 0 [m]
     held_v: np.ndarray        # (D, H) their constant velocities [m/s]
     params: ModelParams       # the force terms' parameters and flags, for the compiled code
+    motion: Motion            # the held nodes' prescribed motion beyond x0 + V t (see model/motion.py)
 
     @property
     def dim(self) -> int:
@@ -100,9 +102,23 @@ def build(scene: S.Scene) -> Model:
     v0[:, held_idx] = held_v[:, held_idx]
 
     layout = Layout(mass, held, node_lengths(scene))
-    return Model(scene=scene, x0=x0, v0=v0, mass=mass, drag=drag, held=held, held_idx=held_idx,
-                 held_x0=np.ascontiguousarray(x0[:, held_idx]), held_v=np.ascontiguousarray(held_v[:, held_idx]),
-                 params=model_params(scene, layout))
+    model = Model(scene=scene, x0=x0, v0=v0, mass=mass, drag=drag, held=held, held_idx=held_idx,
+                  held_x0=np.ascontiguousarray(x0[:, held_idx]), held_v=np.ascontiguousarray(held_v[:, held_idx]),
+                  params=model_params(scene, layout), motion=motion_of(scene, held_idx))
+    if isinstance(scene.initial, S.EquilibriumStart):
+        from .statics import solve_equilibrium
+
+        result = solve_equilibrium(model)
+        if not result.converged:
+            raise EquilibriumError(f"{scene.name}: initial.shape = 'equilibrium': the static solve did not converge "
+                                   f"(largest residual force {result.residual:.3g} N after {result.iterations} "
+                                   f"iterations); start from another shape")
+        model.x0[:] = result.x
+    return model
+
+
+class EquilibriumError(ValueError):
+    """A scene whose static shape could not be found; ``str()`` is one line for the user."""
 
 
 def node_lengths(scene: S.Scene) -> np.ndarray:

@@ -1,8 +1,12 @@
-"""Tension and strain along the rope, per saved frame: what the run folder stores beside positions.
+"""What every saved frame stores besides positions and velocities: each segment's tension and strain, and the
+force each support exerts on its held node.
 
 Segment j joins node j and node j + 1 (node 0 for a loop's last segment). Its tension [N] is the axial force
 of :func:`ropesim.model.forces.springs.segment_forces` (the spring's k (r - l0), none while a slack segment
-is short, plus the axial damping), positive when it pulls; its strain is r / l0 - 1.
+is short, plus the axial damping), positive when it pulls; its strain is r / l0 - 1. A support (a pin or a
+drive) pushes its held node with m a_p - F, F the net force of every term on the node (the linear drag
+included) and a_p its prescribed acceleration: for the fairlead of a mooring line, the line's pull on the
+vessel is minus that, and its magnitude the fairlead tension.
 """
 
 from __future__ import annotations
@@ -10,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 
 from .forces.springs import pair_spring_stretch, segment_forces
-
-FRAME_ARRAYS = ("tension", "strain")   # per saved frame, (F, S) each, S the number of segments
+from .motion import offset
+from .terms import accelerations
 
 
 def segment_count(model) -> int:
@@ -19,11 +23,41 @@ def segment_count(model) -> int:
     return rope.nodes if rope.closed else rope.nodes - 1
 
 
-def frame_arrays(model, x: np.ndarray, v: np.ndarray) -> dict[str, np.ndarray]:
-    """{"tension": (F, S) [N], "strain": (F, S) [-]} for frames x, v (F, N, D)."""
+def frame_shapes(model) -> dict[str, tuple]:
+    """Each stored per-frame array's shape, frame axis left out."""
+    shapes = {"tension": (segment_count(model),), "strain": (segment_count(model),)}
+    if model.held_idx.size:
+        shapes["support"] = (model.held_idx.size, model.dim)
+    return shapes
+
+
+def frame_arrays(model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> dict[str, np.ndarray]:
+    """{"tension": (F, S) [N], "strain": (F, S) [-], "support": (F, H, D) [N] if any node is held} for frames
+    at times t (F,) with positions and velocities x, v (F, N, D)."""
     rope = model.scene.rope
-    return {"tension": segment_forces(model, x, v),
-            "strain": pair_spring_stretch(x, rope.segment_length, 1, rope.closed)}
+    out = {"tension": segment_forces(model, x, v), "strain": pair_spring_stretch(x, rope.segment_length, 1,
+                                                                                   rope.closed)}
+    if model.held_idx.size:
+        out["support"] = support_forces(model, t, x, v)
+    return out
+
+
+def support_forces(model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The force [N] each support exerts on its held node, m a_p - F, per frame (F, H, D)."""
+    idx, m = model.held_idx, model.motion
+    mass = model.mass[idx][:, None]
+    acc = np.zeros((model.dim, model.nodes))
+    out = np.zeros((len(t), idx.size, model.dim))
+    for k in range(len(t)):
+        xk, vk = np.ascontiguousarray(np.asarray(x[k]).T), np.ascontiguousarray(np.asarray(v[k]).T)
+        accelerations(xk, vk, acc, model.params, float(t[k]))
+        force = mass * acc[:, idx].T - (model.drag[idx][:, None] * vk[:, idx].T)
+        out[k] = -force
+        if m.moving:
+            for j in range(idx.size):
+                for d in range(model.dim):
+                    out[k, j, d] += mass[j, 0] * offset(m, j, d, float(t[k]))[2]
+    return out
 
 
 def end_tensions(model, tension: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

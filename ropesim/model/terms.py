@@ -18,7 +18,8 @@ Compiled entry points, each the term list in one form:
   ``box_work``;
 - :func:`mechanical_energy`: kinetic plus the conservative terms' energy, for the blow-up check;
 - :func:`coupling_jacobian` and :func:`node_jacobian`: each term's blocks of the stiff integrator's Newton
-  matrix (:mod:`ropesim.model.jacobian`), couplings between nodes and node-local blocks.
+  matrix (:mod:`ropesim.model.jacobian`), couplings between nodes and node-local blocks, assembled with the
+  mass by :func:`newton_matrix`.
 """
 
 from collections import namedtuple
@@ -27,6 +28,7 @@ import numpy as np
 from numba import njit
 
 from .forces.added_mass import ADDED_MASS_TERM, add_added_mass_jacobian, apply_added_mass
+from .forces.bending import EI_TERM, add_ei_bending, add_ei_jacobian, ei_energy
 from .forces.buoyancy import BUOYANCY_TERM, add_buoyancy
 from .forces.fluid import (BODY_DRAG_TERM, FLOW_PUSH_TERM, FLOW_TERM, FLUID_DRAG_TERM, VISCOUS_DRAG_TERM,
                            add_fluid_forces, add_fluid_jacobian)
@@ -37,23 +39,27 @@ from .forces.springs import AXIAL_DAMPING as AXIAL_DAMPING_TERM
 from .forces.springs import BENDING as BENDING_TERM
 from .forces.springs import ROPE
 from .forces.springs import add_axial_damping, add_pair_springs, set_chain_springs
+from .forces.seabed import (SEABED_TERM, add_seabed_contact, add_seabed_friction, add_seabed_jacobian,
+                            seabed_energy)
 from .forces.thrower import THROWER as THROWER_TERM
 from .forces.thrower import add_thrower, add_thrower_jacobian
 from .jacobian import pair_damper_blocks, pair_spring_blocks
 
 TERMS = (ROPE, BENDING_TERM, GRAVITY_TERM, BUOYANCY_TERM, THROWER_TERM, GUIDES_TERM, AXIAL_DAMPING_TERM,
-         FLUID_DRAG_TERM, VISCOUS_DRAG_TERM, BODY_DRAG_TERM, FLOW_TERM, FLOW_PUSH_TERM, ADDED_MASS_TERM)
+         FLUID_DRAG_TERM, VISCOUS_DRAG_TERM, BODY_DRAG_TERM, FLOW_TERM, FLOW_PUSH_TERM, ADDED_MASS_TERM, SEABED_TERM,
+         EI_TERM)
 
 # Positions in ModelParams.flags (uint8), one per optional term: each Term's ``flag``.
 BENDING, GRAVITY, THROWER, GUIDES = BENDING_TERM.flag, GRAVITY_TERM.flag, THROWER_TERM.flag, GUIDES_TERM.flag
 AXIAL_DAMPING, BUOYANCY = AXIAL_DAMPING_TERM.flag, BUOYANCY_TERM.flag
 FLUID_DRAG, VISCOUS_DRAG, BODY_DRAG = FLUID_DRAG_TERM.flag, VISCOUS_DRAG_TERM.flag, BODY_DRAG_TERM.flag
 FLOW, FLOW_PUSH, ADDED_MASS = FLOW_TERM.flag, FLOW_PUSH_TERM.flag, ADDED_MASS_TERM.flag
-N_FLAGS = 12
+SEABED, EI_BENDING = SEABED_TERM.flag, EI_TERM.flag
+N_FLAGS = 14
 
 ModelParams = namedtuple("ModelParams", [
     "inv_mass", "flags", "node_length", "spring", "bending", "gravity", "buoyancy", "thrower", "guides", "axial",
-    "fluid_drag", "viscous_drag", "body_drag", "flow", "flow_push", "added_mass"])
+    "fluid_drag", "viscous_drag", "body_drag", "flow", "flow_push", "added_mass", "seabed", "bending_ei"])
 """What the compiled code knows of the model's forces: 1 / m per node (N,), the on/off flags (N_FLAGS,), each
 node's share of unstretched length (N,) [m], and each term's parameters, in TERMS order (see each term's
 module for its layout)."""
@@ -117,12 +123,17 @@ def position_accelerations(x, acc, p):
         add_pair_springs(x, acc, p.inv_mass, p.bending[0], p.bending[1], 2, closed)
     if p.flags[BUOYANCY]:
         add_buoyancy(acc, p.buoyancy)
+    if p.flags[SEABED]:
+        add_seabed_contact(x, acc, p.inv_mass, p.seabed)
+    if p.flags[EI_BENDING]:
+        add_ei_bending(x, acc, p.inv_mass, p.bending_ei, closed)
 
 
 @njit(cache=True, error_model="numpy")
 def velocity_accelerations(x, v, acc, p, t):
     """Add the acceleration [m/s^2] of the terms that depend on velocities (the thrower, the guides, axial
-    damping, fluid forces) at time t [s]; returns (fluid power, internal-damping power) [W]."""
+    damping, fluid forces, the seabed's damping and friction) at time t [s]; returns the power [W] of the
+    fluid, of the axial damping and of the seabed."""
     closed = p.spring[2] != 0.0
     g = p.gravity[0] if p.flags[GRAVITY] else 0.0
     if p.flags[THROWER]:
@@ -135,13 +146,16 @@ def velocity_accelerations(x, v, acc, p, t):
     fluid = 0.0
     if any_fluid(p.flags):
         fluid = add_fluid_forces(x, v, acc, p, t)
-    return fluid, internal
+    seabed = 0.0
+    if p.flags[SEABED]:
+        seabed = add_seabed_friction(x, v, acc, p.inv_mass, p.seabed, closed)
+    return fluid, internal, seabed
 
 
 @njit(cache=True, error_model="numpy")
 def accelerations(x, v, acc, p, t):
     """Overwrite ``acc`` (D, N) with every term's force / m [m/s^2] at time t [s], the linear [drag] b v and
-    added mass excluded; returns (fluid power, internal-damping power) [W]."""
+    added mass excluded; returns the power [W] of the fluid, the axial damping and the seabed."""
     position_accelerations(x, acc, p)
     return velocity_accelerations(x, v, acc, p, t)
 
@@ -201,6 +215,10 @@ def mechanical_energy(x, v, mass, p):
     e, stretch, node = _springs_energy_and_stretch(x, p.spring[0], p.spring[1], 1, closed, p.spring[3] != 0.0)
     if p.flags[BENDING]:
         e += _springs_energy_and_stretch(x, p.bending[0], p.bending[1], 2, closed, False)[0]
+    if p.flags[SEABED]:
+        e += seabed_energy(x, p.seabed)
+    if p.flags[EI_BENDING]:
+        e += ei_energy(x, p.bending_ei, closed)
     g = p.gravity[0] if p.flags[GRAVITY] else 0.0
     buoyant = p.flags[BUOYANCY] != 0
     for i in range(n):
@@ -224,6 +242,8 @@ def coupling_jacobian(x, jac, beta, free, p):
         pair_spring_blocks(x, jac, p.bending[0], p.bending[1], 2, closed, scale, free, False)
     if p.flags[AXIAL_DAMPING]:
         pair_damper_blocks(x, jac, p.axial[0], closed, beta, free)
+    if p.flags[EI_BENDING]:
+        add_ei_jacobian(x, jac, beta, free, p.bending_ei, p.spring[1], closed)
 
 
 @njit(cache=True, error_model="numpy")
@@ -238,3 +258,30 @@ def node_jacobian(x, v, band, beta, mass, free, p, t):
         add_fluid_jacobian(x, v, band, beta, free, p, t)
     if p.flags[ADDED_MASS]:
         add_added_mass_jacobian(x, band, p.added_mass, free, p.spring[2] != 0.0)
+    if p.flags[SEABED]:
+        add_seabed_jacobian(x, v, band, beta, free, p.seabed, True)
+
+
+@njit(cache=True, error_model="numpy")
+def newton_matrix(x, v, jac, beta, nodes, p, t):
+    """The matrix M (1 + beta gamma) + beta^2 H + beta C_v into ``jac`` (:mod:`ropesim.model.jacobian`): the
+    mass and linear drag on the diagonal, then every term's blocks. ``nodes`` = (free (N,) bool, mass (N,),
+    linear drag b (N,)); a held node's rows are the identity. The stiff integrator's Newton matrix for a stage
+    of coefficient beta = gamma h, and the static solver's with beta its pseudo-time step."""
+    free, mass, drag = nodes
+    band, corner = jac.band, jac.corner
+    dim, n = x.shape
+    band[:] = 0.0
+    corner[:] = 0.0
+    coupling_jacobian(x, jac, beta, free, p)
+    for i in range(n):
+        if not free[i]:
+            for d in range(dim):
+                band[0, i * dim + d] = 1.0
+                for e in range(d + 1, dim):
+                    band[e - d, i * dim + d] = 0.0
+            continue
+        diag = mass[i] + beta * drag[i]
+        for d in range(dim):
+            band[0, i * dim + d] += diag
+    node_jacobian(x, v, band, beta, mass, free, p, t)

@@ -46,12 +46,14 @@ def load_scene(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) ->
         raise SceneError(source, "", "is a folder, not a scene file") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise SceneError(source, "", f"cannot be read ({exc.__class__.__name__})") from None
-    return scene_from_toml(text, source=source, default_name=path.stem, overrides=overrides)
+    return scene_from_toml(text, source=source, default_name=path.stem, overrides=overrides,
+                           base_dir=path.resolve().parent)
 
 
 def scene_from_toml(text: str, source: str = "<scene>", default_name: str = "scene",
-                    overrides: list[str] | tuple[str, ...] = ()) -> S.Scene:
-    """Parse TOML text into a validated scene (see :func:`load_scene`)."""
+                    overrides: list[str] | tuple[str, ...] = (), base_dir: str | Path | None = None) -> S.Scene:
+    """Parse TOML text into a validated scene (see :func:`load_scene`); files it names (a driven node's
+    ``path``) are read relative to ``base_dir`` (default: the current folder)."""
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -60,7 +62,7 @@ def scene_from_toml(text: str, source: str = "<scene>", default_name: str = "sce
         apply_override(raw, item, source)
     if overrides:
         source = f"{source} (with --set {' '.join(overrides)})"
-    return scene_from_dict(raw, source=source, default_name=default_name)
+    return scene_from_dict(raw, source=source, default_name=default_name, base_dir=base_dir)
 
 
 def parse_override(item: str, source: str = "--set") -> tuple[list[str], Any]:
@@ -123,7 +125,8 @@ def _list_item(items: list, part: str, here: str, source: str, item: str):
 # ------------------------------------------------------------------------------------ validation
 
 
-def scene_from_dict(raw: dict, source: str = "<scene>", default_name: str = "scene") -> S.Scene:
+def scene_from_dict(raw: dict, source: str = "<scene>", default_name: str = "scene",
+                    base_dir: str | Path | None = None) -> S.Scene:
     """Validate a raw TOML dict into a :class:`Scene`; raises :class:`SceneError`."""
     allowed = list(S.TOP_LEVEL_SCALARS) + list(S.TABLES) + list(S.ARRAYS_OF_TABLES)
     for key in raw:
@@ -161,7 +164,7 @@ def scene_from_dict(raw: dict, source: str = "<scene>", default_name: str = "sce
         dimension=dim,
         **parts,
     )
-    return _check_scene(scene, source)
+    return _check_scene(scene, source, Path(base_dir) if base_dir is not None else Path.cwd())
 
 
 class _Ctx:
@@ -207,7 +210,7 @@ class _Ctx:
         return start
 
 
-def _check_scene(scene: S.Scene, source: str) -> S.Scene:
+def _check_scene(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
     """Checks that involve more than one key; returns the scene with the defaults that depend on others filled."""
     def fail(key, message):
         raise SceneError(source, key, message)
@@ -216,10 +219,111 @@ def _check_scene(scene: S.Scene, source: str) -> S.Scene:
     _check_topology(scene, fail)
     _check_nodes(scene, fail)
     _check_fluid(scene, fail)
+    scene = _resolve_driven(scene, base_dir, fail)
     scene = _resolve_initial(scene, fail)
     scene = _resolve_omegas(scene, fail)
     _check_flow_covers_the_rope(scene, fail)
+    _check_seabed(scene, fail)
     return scene
+
+
+def _resolve_driven(scene: S.Scene, base_dir: Path, fail) -> S.Scene:
+    """Each drive's defaults (no velocity: still; no phase: 0), its sinusoid complete, its path read."""
+    zeros = (0.0,) * scene.dimension
+    drives = []
+    for g, drive in enumerate(scene.driven):
+        key = f"driven.{g}"
+        drive = replace(drive, velocity=drive.velocity if drive.velocity is not None else zeros)
+        if drive.amplitude is not None:
+            if drive.period is None:
+                fail(f"{key}.period", "missing: a sinusoid needs its period per axis (with amplitude)")
+            if any(a != 0.0 and not T > 0.0 for a, T in zip(drive.amplitude, drive.period)):
+                fail(f"{key}.period", f"must be > 0 on every axis that moves, got {list(drive.period)}")
+            drive = replace(drive, phase=drive.phase if drive.phase is not None else zeros)
+        elif drive.period is not None or drive.phase is not None:
+            fail(f"{key}.{'period' if drive.period is not None else 'phase'}", "is used only with amplitude")
+        if drive.path is not None and drive.path_table is not None:
+            fail(f"{key}.path_table", "give the path either as a CSV file (path) or inline (path_table), not both")
+        if drive.path is not None:
+            drive = replace(drive, path=None, path_table=_read_path(drive.path, base_dir, scene, f"{key}.path", fail))
+        if drive.path_table is not None:
+            _check_path(drive.path_table, scene, f"{key}.path_table", "", fail)
+        drives.append(drive)
+    return replace(scene, driven=tuple(drives))
+
+
+def _read_path(name: str, base_dir: Path, scene: S.Scene, key: str, fail) -> tuple:
+    """The CSV path's rows (t, dx, dy[, dz]), checked like an inline ``path_table``; the file name is taken
+    relative to the scene file's folder."""
+    import csv
+
+    path = Path(name)
+    path = path if path.is_absolute() else (base_dir / path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        fail(key, f"cannot read {path} ({exc.__class__.__name__})")
+    columns = scene.dimension + 1
+    rows = []
+    for number, row in enumerate(csv.reader(text.splitlines()), start=1):
+        if not row or row[0].lstrip().startswith("#"):
+            continue
+        try:
+            values = [float(v) for v in row]
+        except ValueError:
+            if not rows:
+                continue   # a header line
+            fail(key, f"{path}, line {number}: not numbers: {_show(row)}")
+        if len(values) != columns or not all(math.isfinite(v) for v in values):
+            fail(key, f"{path}, line {number}: needs {columns} finite numbers (t, dx, dy{', dz' if columns == 4 else ''}), "
+                      f"got {_show(row)}")
+        rows.append(tuple(values))
+    _check_path(rows, scene, key, f"{path}: ", fail)
+    return tuple(rows)
+
+
+def _check_path(rows, scene: S.Scene, key: str, where: str, fail) -> None:
+    """At least two rows, times increasing from at most 0 to at least t_end, no displacement at t = 0."""
+    if len(rows) < 2:
+        fail(key, f"{where}needs at least two rows of t, dx, dy{', dz' if scene.dimension == 3 else ''}")
+    times = [r[0] for r in rows]
+    for a, b in zip(times, times[1:]):
+        if not b > a:
+            fail(key, f"{where}times must increase, but {b:g} s follows {a:g} s")
+    if times[0] > 0.0 or times[-1] < scene.integrator.t_end:
+        fail(key, f"{where}covers t = {times[0]:g} to {times[-1]:g} s, but the run goes from 0 to "
+                  f"{scene.integrator.t_end:g} s")
+    start = [float(v) for v in _interpolate(rows, 0.0)]
+    if any(abs(v) > 1e-12 for v in start):
+        fail(key, f"{where}the displacement at t = 0 is {start}, not zero (the path moves the node from where "
+                  f"the scene starts it)")
+
+
+def _interpolate(rows, t: float) -> tuple:
+    import numpy as np
+
+    table = np.asarray(rows)
+    return tuple(np.interp(t, table[:, 0], table[:, c]) for c in range(1, table.shape[1]))
+
+
+def _check_seabed(scene: S.Scene, fail) -> None:
+    """A seabed needs a footprint, and no held node may start below it (an anchor sits on or above it)."""
+    bed = scene.seabed
+    if bed is None:
+        return
+    if bed.contact_width is None and scene.rope.diameter is None:
+        fail("seabed.contact_width", "missing: the seabed pushes on a footprint contact_width x node length; give "
+                                     "it, or rope.diameter")
+    from .shapes import initial_positions
+
+    x = initial_positions(scene)
+    slope = math.radians(bed.slope)
+    below = (bed.height + math.tan(slope) * x[0] - x[1]) * math.cos(slope)
+    held = set(scene.pinned.nodes if scene.pinned else ()) | {i for d in scene.driven for i in d.nodes}
+    for i in sorted(scene.node(i) for i in held):
+        if below[i] > 1e-9 * max(1.0, abs(bed.height)):
+            fail("seabed.height", f"puts the seabed {below[i]:.6g} m above held node {i} (at y = {x[1][i]:.6g} m): "
+                                  f"an anchor sits on the seabed or above it")
 
 
 PER_NODE_KEYS = ("nodes", "segment_length", "stiffness", "mass")
@@ -399,6 +503,15 @@ def _check_nodes(scene: S.Scene, fail) -> None:
             held[node] = key
     if len(held) == n:
         fail("pinned" if scene.pinned else "driven", "every node is held; at least one must be free to move")
+    for j, i in enumerate(scene.pinned.clamped or () if scene.pinned else ()):
+        key = f"pinned.clamped[{j}]"
+        node = index(key, i)
+        if scene.rope.closed or node not in (0, n - 1):
+            fail(key, f"node {node} is not an end of an open line; only a line's end can be clamped")
+        if node not in {index("pinned.nodes", k) for k in scene.pinned.nodes}:
+            fail(key, f"node {node} is clamped but not pinned; list it in pinned.nodes too")
+        if not scene.rope.EI:
+            fail(key, "a clamp holds the end's direction against bending: it needs rope.EI")
 
     seen: dict[int, str] = {}
     for j, o in enumerate(scene.overrides):
@@ -432,8 +545,11 @@ def _resolve_initial(scene: S.Scene, fail) -> S.Scene:
         for i, j in pairs:
             if pts[i] == pts[j]:
                 fail("initial.points", f"nodes {i} and {j} coincide; a spring between them has no direction")
-    if isinstance(init, S.LineStart) and init.start == init.end:
+    if isinstance(init, (S.LineStart, S.EquilibriumStart)) and init.start == init.end:
         fail("initial.end", "equals initial.start; a line needs two distinct ends")
+    if isinstance(init, S.EquilibriumStart) and rope.closed:
+        fail("initial.shape", "'equilibrium' starts an open line between two ends; a loop starts as "
+                              "'square_loop' or 'points'")
     return scene
 
 
@@ -510,6 +626,13 @@ def _value(value: Any, sp: S.Spec, key: str, source: str, dim: int):
         if not isinstance(value, list) or not value:
             bad(f"must be a list of points, each a list of {dim} numbers")
         return tuple(_vector(p, dim, f"{key}[{i}]", source, sp) for i, p in enumerate(value))
+    if sp.kind == "rows":
+        ok = isinstance(value, list) and value and all(
+            isinstance(row, list) and len(row) == dim + 1 and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and _finite(v) for v in row) for row in value)
+        if not ok:
+            bad(f"must be a list of rows, each {dim + 1} finite numbers (t, then one per axis)")
+        return tuple(tuple(float(v) for v in row) for row in value)
     raise AssertionError(sp.kind)
 
 

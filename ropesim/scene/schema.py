@@ -21,8 +21,8 @@ from typing import Any
 class Spec:
     """What one TOML key may hold.
 
-    kind: "int", "float", "bool", "str", "vector" (one number per dimension), "int_list", "float_list" or
-    "points" (a list of vectors). ``low``/``high`` bound numbers (``open_low`` makes the lower bound strict).
+    kind: "int", "float", "bool", "str", "vector" (one number per dimension), "int_list", "float_list",
+    "points" (a list of vectors) or "rows" (a table: rows of a time and one number per dimension). ``low``/``high`` bound numbers (``open_low`` makes the lower bound strict).
     """
 
     kind: str
@@ -59,6 +59,9 @@ class Rope:
       scene shows both forms.
 
     ``axial_damping`` (BA) adds a force BA (dl/dt) / l along each segment, in tension and compression.
+    ``EI`` gives the rope bending stiffness: each joint between segments stores EI (1 - cos theta) / l_j, theta
+    the angle between the two segments and l_j the mean of their rest lengths (EI kappa^2 / 2 per length for
+    small angles, kappa = theta / l_j); the forces are that energy's gradient.
     ``compression = false`` makes segments slack when shorter than their rest length (a real rope; the
     default in physical units), ``true`` makes them push back (the course's springs; the per-node default).
     ``diameter`` (either form) is what fluid drag, buoyancy and added mass act on.
@@ -87,6 +90,8 @@ class Rope:
                             open_low=True)
     axial_damping: float | None = spec("float", "internal damping BA: force BA (dl/dt) / l along each segment",
                                        "N s", default=None, required=False, low=0)
+    EI: float | None = spec("float", "bending stiffness EI: energy EI (1 - cos theta) / l at each joint",
+                            "N m^2", default=None, required=False, low=0, open_low=True)
     compression: bool | None = spec("bool", "segments push back when shorter than their rest length (default: "
                                             "true per node, false in physical units)", default=None, required=False)
 
@@ -98,6 +103,39 @@ class Rope:
     @property
     def segment_count(self) -> int:
         return self.nodes if self.closed else self.nodes - 1
+
+
+@dataclass(frozen=True)
+class Seabed:
+    """A seabed or ground: the plane y = height + tan(slope) x, with the scene's nodes pushed out of it.
+
+    A node that sinks a depth delta below the plane (measured along its normal n) feels
+    (k delta - c v_n) A along n, A = contact_width x L (its share of unstretched length), with the contact
+    stiffness k and damping c per unit area (MoorDyn's kBot and cBot; MoorDyn's defaults). Sliding on it, the
+    node feels Coulomb-like friction against its sliding velocity v_s (v minus its normal part), split along
+    and across the rope (the node tangent projected on the plane):
+
+        F = -N (mu_axial v_axial + mu v_across) / sqrt(|v_s|^2 + v_reg^2),   N = k delta A,
+
+    which is mu N at speeds well above ``friction_speed`` v_reg and a stiff linear drag below it: the
+    regularisation that makes friction smooth. A line on a slope below its critical angle (tan = mu) creeps at
+    about v_reg tan(slope) / mu instead of sticking; above it, it slides. The contact's spring energy is
+    conservative; its damping and friction are booked as the ledger's ``seabed_work``.
+    """
+
+    height: float = spec("float", "height y of the plane at x = 0", "m")
+    slope: float = spec("float", "angle of the plane, rising towards +x", "deg", default=0.0, low=-60.0, high=60.0)
+    stiffness: float = spec("float", "contact stiffness per unit area kBot", "N/m^3", default=3.0e6, low=0,
+                            open_low=True)
+    damping: float = spec("float", "contact damping per unit area cBot", "N s/m^3", default=3.0e5, low=0)
+    friction: float = spec("float", "friction coefficient mu (across the rope, and along it unless "
+                                    "friction_axial is given)", default=0.0, low=0)
+    friction_axial: float | None = spec("float", "friction coefficient along the rope", default=None,
+                                        required=False, low=0)
+    friction_speed: float = spec("float", "regularisation speed v_reg: friction is full above it", "m/s",
+                                 default=0.01, low=0, open_low=True)
+    contact_width: float | None = spec("float", "width of a node's footprint (default: the rope's diameter)", "m",
+                                       default=None, required=False, low=0, open_low=True)
 
 
 @dataclass(frozen=True)
@@ -263,13 +301,28 @@ class PointsStart:
     shape: str = "points"
 
 
+@dataclass(frozen=True)
+class EquilibriumStart:
+    """The static shape between ``start`` (node 0) and ``end`` (the last node), found by ``ropesim
+    equilibrium``'s solver before the run: every force (weight, buoyancy, springs, bending, a seabed, drag in
+    a steady flow at its full strength) balanced at every free node, the held nodes where the scene holds
+    them. A rope longer than the distance between its ends starts from a sagging guess. So a dynamic run
+    starts without the transient a straight or hanging start would cause."""
+
+    start: tuple = spec("vector", "position of node 0", "m")
+    end: tuple = spec("vector", "position of the last node", "m")
+    velocity: tuple = spec("vector", "initial velocity of every node", "m/s", default=None, required=False)
+    shape: str = "equilibrium"
+
+
 INITIAL_SHAPES = {
     "hanging": HangingStart,
     "line": LineStart,
     "square_loop": SquareLoopStart,
     "points": PointsStart,
+    "equilibrium": EquilibriumStart,
 }
-InitialShape = HangingStart | LineStart | SquareLoopStart | PointsStart
+InitialShape = HangingStart | LineStart | SquareLoopStart | PointsStart | EquilibriumStart
 
 
 # ---------------------------------------------------------------------- nodes held or overridden
@@ -288,17 +341,48 @@ class NodeOverride:
 
 @dataclass(frozen=True)
 class Pinned:
-    """Nodes held fixed at their initial positions."""
+    """Nodes held fixed at their initial positions. A pinned end of a rope with bending stiffness (``rope.EI``)
+    may also be ``clamped``: its end segment then keeps its initial direction, bent against a joint of
+    stiffness 2 EI / l at the clamp (a cantilever's fixed end; a joint covering half a segment, as MoorDyn's
+    clamped rod end)."""
 
     nodes: tuple = spec("int_list", "indices of the pinned nodes (negative counts from the end)")
+    clamped: tuple | None = spec("int_list", "pinned end nodes (0 or -1) whose end segment keeps its direction",
+                                 default=None, required=False)
 
 
 @dataclass(frozen=True)
 class Driven:
-    """Nodes moved at a constant velocity: x(t) = x(0) + V t exactly (the helicopter's grip)."""
+    """Nodes moved along a prescribed path (the helicopter's grip, a vessel's fairlead):
+
+        x(t) = x(0) + V t + r(t) [A sin(2 pi t / T + phi) - A sin(phi) + p(t)]
+
+    exactly, at every stage of every method: a constant ``velocity`` V, a sinusoid per axis (``amplitude`` A,
+    ``period`` T, ``phase`` phi in degrees; an axis with A = 0 stays still) and a piecewise-linear ``path`` p(t)
+    read from a CSV file of rows t, dx, dy[, dz] or given inline as ``path_table`` (displacements, p(0) = 0,
+    times increasing and covering the run; the loader reads the file into ``path_table``, so a resolved scene
+    carries its path with it), both ramped in by r(t) = (1 - cos(pi t / ramp_time)) / 2 until ``ramp_time`` (1 from then on, or
+    always when it is 0). The node's velocity and acceleration follow; the force its support exerts is
+    reported (``support`` in each saved frame).
+    """
 
     nodes: tuple = spec("int_list", "indices of the driven nodes (negative counts from the end)")
-    velocity: tuple = spec("vector", "the constant velocity V", "m/s")
+    velocity: tuple | None = spec("vector", "the constant velocity V", "m/s", default=None, required=False)
+    amplitude: tuple | None = spec("vector", "sinusoid: amplitude A per axis", "m", default=None, required=False)
+    period: tuple | None = spec("vector", "sinusoid: period T per axis (ignored where A = 0)", "s", default=None,
+                                required=False)
+    phase: tuple | None = spec("vector", "sinusoid: phase phi per axis", "deg", default=None, required=False)
+    path: str | None = spec("str", "CSV file of t, dx, dy[, dz] rows (relative to the scene file's folder)",
+                            default=None, required=False)
+    path_table: tuple | None = spec("rows", "the path inline: rows [t, dx, dy(, dz)] (instead of a CSV file)",
+                                    "s, m", default=None, required=False)
+    ramp_time: float = spec("float", "time over which the sinusoid and the path ramp in (0: at once)", "s",
+                            default=0.0, low=0)
+
+    @property
+    def moving(self) -> bool:
+        """True when the motion is more than a constant velocity."""
+        return self.amplitude is not None or self.path is not None or self.path_table is not None
 
 
 # ----------------------------------------------------------------------------- string shooter
@@ -392,6 +476,7 @@ class Scene:
     viscous_drag: ViscousDrag | None = None
     buoyancy: Buoyancy | None = None
     added_mass: AddedMass | None = None
+    seabed: Seabed | None = None
     bending: Bending | None = None
     thrower: Thrower | None = None
     guides: tuple[Guide, ...] = ()
@@ -422,6 +507,7 @@ TABLES = {
     "viscous_drag": ViscousDrag,
     "buoyancy": Buoyancy,
     "added_mass": AddedMass,
+    "seabed": Seabed,
     "bending": Bending,
     "thrower": Thrower,
     "pinned": Pinned,
@@ -441,7 +527,7 @@ def scene_to_dict(scene: Scene) -> dict:
         if hasattr(obj, "shape"):
             out["shape"] = obj.shape
         for f in fields(obj):
-            if f.name == "shape":
+            if f.name == "shape" or "spec" not in f.metadata:   # a value the loader derived, not a key
                 continue
             value = getattr(obj, f.name)
             if f.name == "omega0" and value is None:

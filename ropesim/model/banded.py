@@ -1,4 +1,5 @@
-"""Solves with the stiff integrator's Newton matrix: banded Cholesky, and a Woodbury correction for a loop.
+"""Solves with the rope's Newton matrix (the stiff integrator's and the static solver's): banded Cholesky, and
+a Woodbury correction for a loop.
 
 The matrix is symmetric positive definite and block banded (see :mod:`ropesim.model.jacobian` for its
 storage); :func:`factor` factors it in place in O(N) and :func:`solve` solves with the factors. On a closed

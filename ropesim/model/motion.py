@@ -1,0 +1,104 @@
+"""Prescribed motion of held nodes: x(t) = x0 + V t + r(t) [sinusoid(t) + path(t)] (see ``[[driven]]``).
+
+Pinned nodes and constant-velocity drives need nothing from here: the compiled loops place them at x0 + V t
+themselves. When any drive moves otherwise (``Motion.moving``), the loops call :func:`place_moving` whenever
+time changes: it puts every held node where it must be at time t, sets its velocity in ``v``, and writes the
+held nodes' current velocity and acceleration into the ``Held`` bundle's ``v`` and ``Motion.accel`` arrays,
+which the loops read for the supports' power on the rope (a support pushes m a - F, with a the prescribed
+acceleration). The path is piecewise linear: its velocity jumps at its rows, and its acceleration there (an
+impulse) is left out of the supports' power, a ledger error of the order of the jump times the step.
+
+Parameters (per held node j, axis d): ``base`` (D, H) the constant velocity V; ``amp``, ``omega``, ``phase``
+(D, H) the sinusoid A sin(omega t + phase) - A sin(phase); ``ramp`` (H,) the ramp time; ``path_t`` (K,) and
+``path_d`` (D, K) every path's rows, concatenated, and ``span`` (H, 2) the rows of node j's path (empty if
+none); ``accel`` (D, H) written by :func:`place_moving`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+Motion = namedtuple("Motion", ["moving", "base", "amp", "omega", "phase", "ramp", "path_t", "path_d", "span", "accel"])
+
+
+def motion_of(scene, held_idx: np.ndarray) -> Motion:
+    """The held nodes' prescribed motion (all zero and ``moving`` False for pins and constant drives)."""
+    dim, h = scene.dimension, len(held_idx)
+    base, amp, omega, phase = (np.zeros((dim, h)) for _ in range(4))
+    ramp, span = np.zeros(h), np.zeros((h, 2), dtype=np.int64)
+    times, rows = [], []
+    where = {int(i): j for j, i in enumerate(held_idx)}
+    for drive in scene.driven:
+        first = len(times)
+        if drive.path_table is not None:
+            table = np.asarray(drive.path_table)
+            times.extend(table[:, 0])
+            rows.extend(table[:, 1:])
+        for node in drive.nodes:
+            j = where[scene.node(node)]
+            base[:, j] = drive.velocity
+            ramp[j] = drive.ramp_time
+            if drive.amplitude is not None:
+                amp[:, j] = drive.amplitude
+                omega[:, j] = [2.0 * math.pi / T if a != 0.0 else 0.0 for a, T in zip(drive.amplitude, drive.period)]
+                phase[:, j] = np.radians(drive.phase)
+            span[j] = (first, len(times))
+    path_d = np.asarray(rows, dtype=float).T.copy() if rows else np.zeros((dim, 0))
+    moving = any(d.moving for d in scene.driven)
+    return Motion(moving, base, amp, omega, phase, ramp, np.asarray(times, dtype=float), path_d, span,
+                  np.zeros((dim, h)))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def ramp_factor(t, ramp):
+    """(r, dr/dt, d2r/dt2) of the ramp (1 - cos(pi t / T)) / 2 until T, 1 after (and always when T = 0)."""
+    if ramp <= 0.0 or t >= ramp:
+        return 1.0, 0.0, 0.0
+    if t <= 0.0:
+        return 0.0, 0.0, 0.0
+    w = math.pi / ramp
+    return 0.5 * (1.0 - math.cos(w * t)), 0.5 * w * math.sin(w * t), 0.5 * w * w * math.cos(w * t)
+
+
+@njit(cache=True, error_model="numpy")
+def offset(m, j, d, t):
+    """(position, velocity, acceleration) of held node j's motion along axis d at time t, beyond x0 + V t."""
+    s = ds = dds = 0.0
+    a = m.amp[d, j]
+    if a != 0.0:
+        arg = m.omega[d, j] * t + m.phase[d, j]
+        w = m.omega[d, j]
+        s = a * (math.sin(arg) - math.sin(m.phase[d, j]))
+        ds = a * w * math.cos(arg)
+        dds = -a * w * w * math.sin(arg)
+    lo, hi = m.span[j, 0], m.span[j, 1]
+    if hi > lo:
+        k = lo
+        while k + 2 < hi and m.path_t[k + 1] <= t:
+            k += 1
+        t0, t1 = m.path_t[k], m.path_t[k + 1]
+        slope = (m.path_d[d, k + 1] - m.path_d[d, k]) / (t1 - t0)
+        s += m.path_d[d, k] + slope * (t - t0)
+        ds += slope
+    r, dr, ddr = ramp_factor(t, m.ramp[j])
+    return r * s, dr * s + r * ds, ddr * s + 2.0 * dr * ds + r * dds
+
+
+@njit(cache=True, error_model="numpy")
+def place_moving(x, v, held, t):
+    """Put every held node at its prescribed place at time t, set its velocity in ``v`` and in ``held.v``,
+    and its acceleration in ``held.motion.accel``."""
+    idx, x0, hv, m = held
+    dim = x.shape[0]
+    for j in range(idx.shape[0]):
+        i = idx[j]
+        for d in range(dim):
+            s, ds, dds = offset(m, j, d, t)
+            x[d, i] = x0[d, j] + m.base[d, j] * t + s
+            hv[d, j] = m.base[d, j] + ds
+            v[d, i] = hv[d, j]
+            m.accel[d, j] = dds
