@@ -107,7 +107,7 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
     with (nullcontext(interrupted) if interrupted is not None else stop_signals()) as flag:
         if integrator is None:
             integrator = make_integrator(model, grid)
-        if integrator.step == 0:
+        if integrator.step == 0 and store.count == 0:
             store.append(np.zeros(1), integrator.x[None], integrator.v[None], np.zeros((1, len(LEDGER_COLUMNS))))
             if on_chunk is not None:
                 on_chunk(integrator, 0.0)
@@ -187,6 +187,37 @@ def _blow_up_message(model: Model, integrator: Integrator, code: int, node: int)
 def _round_to(n: int, multiple: int) -> int:
     """``n`` rounded to a positive multiple of ``multiple`` (so chunks end on saved frames)."""
     return max(multiple, (n // multiple) * multiple)
+
+
+# Measured cost of the kernel per node and step [ns] (helicopter_mass at 21 and 201 nodes, the larger of the
+# two; scripts/bench_runfolder.py --costs), and of deriving and writing a saved frame per node [ns].
+NS_PER_NODE_STEP = {"symplectic_euler": 4.2, "verlet": 6.2, "yoshida4": 19.0, "pefrl": 20.0, "rk4": 180.0,
+                    "sdirk2": 1100.0}
+NS_PER_NODE_FRAME = 150.0
+WARN_BYTES = 2 * 10 ** 9        # `run` and `check` warn above this much output
+WARN_SECONDS = 15 * 60          # ... or this long a run
+
+
+@dataclass
+class Estimate:
+    """What a run will take before it starts: its frames, their bytes (the run folder's finished size; while
+    it finishes, the checkpoint streams and trajectory.npz exist together: ``peak_bytes``) and its run time."""
+
+    frames: int
+    bytes: int
+    peak_bytes: int
+    seconds: float
+
+
+def estimate(scene: Scene, model: Model | None = None) -> Estimate:
+    """The output size and run time of ``scene``, from its time grid and the method's measured cost."""
+    model = model if model is not None else build(scene)
+    grid = TimeGrid.of(scene)
+    row = 8 * sum(int(np.prod(s, dtype=np.int64)) for s in frame_specs(model).values())
+    total = grid.frames * row
+    cost = NS_PER_NODE_STEP.get(scene.integrator.method, max(NS_PER_NODE_STEP.values()))
+    seconds = 1e-9 * model.nodes * (grid.steps * cost + grid.frames * NS_PER_NODE_FRAME)
+    return Estimate(frames=grid.frames, bytes=total, peak_bytes=2 * total, seconds=seconds)
 
 
 CHECKPOINT_SECONDS = 5.0   # a run folder commits a checkpoint at most this often (and at every stop)
@@ -378,6 +409,11 @@ class _DiskStore:
         if self.thread.is_alive():
             self.queue.put(None)
             self.thread.join()
+
+    @property
+    def count(self) -> int:
+        self.drain()
+        return self.writer.count
 
     def arrays(self) -> dict:
         self.drain()

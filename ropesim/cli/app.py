@@ -1,8 +1,8 @@
 """The command line. Each command parses its options and calls one function elsewhere.
 
 Bad input (a scene file, a --set, a run folder) prints one line naming the file, the key and what is
-allowed, and exits with code 2; a run that blows up exits 3; an interrupted run exits 130. Both keep what
-they computed.
+allowed, and exits with code 2; a run that blows up exits 3; a run folder that cannot be written (a full
+disk) exits 4; a run stopped by Ctrl-C, SIGTERM or SIGHUP exits 130, 143 or 129. All keep what they computed.
 """
 
 from __future__ import annotations
@@ -60,7 +60,18 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     context_settings={"help_option_names": ["-h", "--help"]},
 )
-EXIT_BAD_INPUT, EXIT_BLEW_UP, EXIT_INTERRUPTED = 2, 3, 130
+EXIT_BAD_INPUT, EXIT_BLEW_UP, EXIT_WRITE, EXIT_INTERRUPTED = 2, 3, 4, 130
+SIGNAL_EXIT = {"SIGINT": 130, "SIGTERM": 143, "SIGHUP": 129}   # 128 + the signal's number, as a shell reports
+
+
+from ..stop import Stopped  # noqa: E402
+
+
+def exit_code(exc: BaseException | None = None, name: str = "") -> int:
+    """The exit code of a stop: by the signal's name, or the Stopped exception that carries one."""
+    if isinstance(exc, Stopped):
+        name = exc.name
+    return SIGNAL_EXIT.get(name, EXIT_INTERRUPTED)
 
 SceneArg = Annotated[str, typer.Argument(
     metavar="SCENE", help="A scene file (TOML), or the name of a built-in scene such as helicopter_mass "
@@ -115,39 +126,126 @@ def _load(scene: str, sets: list[str] | None):
 
 @app.command(cls=Command)
 def run(
-    scene_file: SceneArg,
-    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Run folder (default runs/<scene name>/).",
+    scene_file: Annotated[Optional[str], typer.Argument(
+        metavar="SCENE", help="A scene file (TOML), or the name of a built-in scene such as helicopter_mass "
+                              "(`ropesim scenarios` lists them); not with --resume.", show_default=False)] = None,
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Run folder (default runs/<scene name>/). An "
+                                                "earlier run there is replaced whole, pictures included.",
                                                 show_default=False)] = None,
     sets: SetOpt = None,
+    resume: Annotated[Optional[Path], typer.Option(
+        "--resume", metavar="RUN_DIR", help="Continue the interrupted or killed run in RUN_DIR from its last "
+                                            "checkpoint, bit for bit as if it had never stopped; with --set "
+                                            "integrator.t_end=T, extend it (a finished run too).",
+        show_default=False)] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")] = False,
     animate_: Annotated[bool, typer.Option("--animate", help="Then animate the run into RUN_FOLDER/animation.gif "
                                                              "(more choices: `ropesim animate`).")] = False,
     fps: FpsOpt = 25.0,
     force: Annotated[bool, typer.Option("--force", help="Run even when dt is above the method's stability bound "
-                                                        "(see `ropesim check`).")] = False,
+                                                        "(see `ropesim check`) or the disk looks too small for "
+                                                        "the frames.")] = False,
 ) -> None:
-    """Run a scene and write trajectory.npz, scene.toml and summary.json into its run folder."""
+    """Run a scene and write trajectory.npz, ledger.npz, scene.toml and summary.json into its run folder.
+
+    Frames stream to the folder in checkpoints; Ctrl-C, SIGTERM or SIGHUP stop the run at its next chunk and
+    keep them, and `ropesim run --resume RUN_DIR` continues it.
+    """
     from .report import print_summary
+    from ..io.runfolder import DiskFull, RunFolderError
     from ..run import BLEW_UP, INTERRUPTED, simulate
 
-    scene, where = _load(scene_file, sets)
-    _check_time_step(scene, where, force, quiet)
-    folder = out if out is not None else Path("runs") / scene.name
-    if folder.exists() and not folder.is_dir():
-        fail(f"--out {folder}: exists and is not a folder")
+    progress = not quiet and sys.stderr.isatty()
+    if resume is not None:
+        if scene_file is not None or out is not None:
+            fail("--resume RUN_DIR continues the run in RUN_DIR: give no SCENE and no --out with it")
+        folder, where = resume, str(resume)
+        t_end = _resume_t_end(sets)
+        run_it = (lambda: _resume(folder, t_end, progress))
+    else:
+        if scene_file is None:
+            fail("missing SCENE: a scene file or a built-in scene's name (or --resume RUN_DIR)")
+        scene, where = _load(scene_file, sets)
+        _check_time_step(scene, where, force, quiet)
+        folder = out if out is not None else Path("runs") / scene.name
+        if folder.exists() and not folder.is_dir():
+            fail(f"--out {folder}: exists and is not a folder")
+        blocked = next((p for p in folder.parents if p.exists() and not p.is_dir()), None)
+        if blocked is not None:
+            fail(f"--out {folder}: cannot write the run folder: {blocked} is a file, not a folder")
+        _check_size(scene, where, folder, force, quiet)
+        run_it = (lambda: simulate(scene, folder, progress=progress))
     try:
-        traj = simulate(scene, folder, progress=not quiet and sys.stderr.isatty())
+        traj = run_it()
+    except DiskFull as exc:
+        fail(str(exc), EXIT_WRITE)
+    except RunFolderError as exc:
+        fail(str(exc))
     except OSError as exc:
-        fail(f"{folder}: cannot write the run folder ({exc.strerror or exc})")
+        fail(f"{folder}: cannot write the run folder ({exc.strerror or exc})", EXIT_WRITE)
     summary = traj.summary
     if not quiet:
         print_summary(summary, folder)
     if summary["status"] == BLEW_UP:
         fail(f"{where}: {summary['message']}; frames up to then are in {folder}", EXIT_BLEW_UP)
     if summary["status"] == INTERRUPTED:
-        fail(f"{where}: {summary['message']}; frames up to then are in {folder}", EXIT_INTERRUPTED)
+        by = summary.get("stopped_by", "SIGINT")
+        fail(f"{where}: {summary['message']}" + (f" by {by}" if by != "SIGINT" else "")
+             + f"; frames up to then are in {folder}; `ropesim run --resume {folder}` continues it",
+             exit_code(name=by))
     if animate_:
         _animate(folder, None, quiet, fps=fps)
+
+
+def _resume_t_end(sets: list[str] | None) -> float | None:
+    """The new t_end of ``--resume --set integrator.t_end=T``; any other --set is refused."""
+    t_end = None
+    for item in sets or []:
+        key, _, value = item.partition("=")
+        if key.strip() != "integrator.t_end":
+            fail(f"--set {item}: with --resume only integrator.t_end may change (the rest of the scene is the "
+                 f"run's own scene.toml)")
+        try:
+            t_end = float(value)
+        except ValueError:
+            t_end = float("nan")
+        if not (t_end >= 0 and t_end < float("inf")):
+            fail(f"--set {item}: integrator.t_end must be a number of seconds >= 0")
+    return t_end
+
+
+def _resume(folder: Path, t_end: float | None, progress: bool):
+    from ..run import resume
+
+    return resume(folder, t_end, progress=progress)
+
+
+def _check_size(scene, where: str, folder: Path, force: bool, quiet: bool) -> None:
+    """Warn when the output or the run time is large; refuse (exit 2) unless --force when the disk cannot
+    hold the frames."""
+    from ..io.runfolder import free_bytes, human
+    from ..run import WARN_BYTES, WARN_SECONDS, estimate
+
+    est = estimate(scene)
+    free = free_bytes(folder)
+    if est.peak_bytes > free and not force:
+        fail(f"{where}: the run would write about {human(est.bytes)} of frames ({est.frames:,} frames; "
+             f"{human(est.peak_bytes)} while it finishes) and {folder} has {human(free)} free; raise "
+             f"output.interval, shorten integrator.t_end, choose another --out, or --force to run anyway")
+    if not quiet and (est.bytes > WARN_BYTES or est.seconds > WARN_SECONDS):
+        typer.echo(f"ropesim: warning: {where}: a large run: about {human(est.bytes)} of frames ({est.frames:,} "
+                   f"frames) and about {_duration(est.seconds)} of computing; Ctrl-C stops it cleanly and "
+                   f"`ropesim run --resume` continues it", err=True)
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.0f} min"
+    if seconds < 2 * 86400:
+        return f"{seconds / 3600:.1f} h"
+    return f"{seconds / 86400:.0f} days"
 
 
 def _check_time_step(scene, where: str, force: bool, quiet: bool) -> None:
@@ -172,8 +270,21 @@ def check(scene_file: SceneArg, sets: SetOpt = None) -> None:
     """Validate a scene and show what it contains and its stability bound, without running it."""
     from .report import print_check
 
+    from ..io.runfolder import free_bytes, human
+    from ..run import WARN_BYTES, WARN_SECONDS, estimate
+
     scene, where = _load(scene_file, sets)
     print_check(scene, where)
+    est, folder = estimate(scene), Path("runs") / scene.name
+    free = free_bytes(folder)
+    typer.echo(f"output: about {human(est.bytes)} in {est.frames:,} frames ({human(est.peak_bytes)} while the "
+               f"run finishes; {human(free)} free at {folder}); run time about {_duration(est.seconds)}")
+    if est.peak_bytes > free:
+        typer.echo(f"ropesim: warning: {where}: the disk at {folder} cannot hold the frames; `ropesim run` "
+                   f"refuses it without --force", err=True)
+    elif est.bytes > WARN_BYTES or est.seconds > WARN_SECONDS:
+        typer.echo(f"ropesim: warning: {where}: a large run (about {human(est.bytes)}, {_duration(est.seconds)})",
+                   err=True)
 
 
 @app.command(cls=Command)
@@ -328,8 +439,8 @@ def _picture(make):
         fail(str(exc))
     except OSError as exc:
         fail(f"{exc.filename or 'output'}: cannot write ({exc.strerror or exc})")
-    except KeyboardInterrupt:
-        fail("interrupted; no picture written", EXIT_INTERRUPTED)
+    except (KeyboardInterrupt, Stopped) as exc:
+        fail("interrupted; no picture written", exit_code(exc))
 
 
 def _animate(run_dir: Path, out: Optional[Path], quiet: bool, **options) -> None:
@@ -555,13 +666,26 @@ def stability(
     print_stability(result, folder)
 
 
+def _raise_stopped(signum, _frame) -> None:
+    import signal
+
+    raise Stopped(signal.Signals(signum).name)
+
+
 def main() -> None:
-    """Entry point. A Ctrl-C outside a run's own clean stop (say, while Python imports) is one line too."""
+    """Entry point. SIGTERM and SIGHUP end a command as Ctrl-C does (a run stops cleanly at its next chunk and
+    keeps its frames); outside a run's own clean stop (say, while Python imports) they are one line too."""
+    import signal
+
+    for name in ("SIGTERM", "SIGHUP"):
+        if hasattr(signal, name):
+            signal.signal(getattr(signal, name), _raise_stopped)
     try:
         app()
-    except KeyboardInterrupt:
-        typer.echo("ropesim: interrupted", err=True)
-        sys.exit(EXIT_INTERRUPTED)
+    except (KeyboardInterrupt, Stopped) as exc:
+        name = exc.name if isinstance(exc, Stopped) else "SIGINT"
+        typer.echo(f"ropesim: {'interrupted' if name == 'SIGINT' else f'stopped by {name}'}", err=True)
+        sys.exit(exit_code(exc))
 
 
 if __name__ == "__main__":  # pragma: no cover
