@@ -389,9 +389,27 @@ ViewOpt = Annotated[Optional[str], typer.Option(
 
 
 def _check_fps(fps: float) -> float:
-    if not fps > 0:
-        fail(f"--fps {fps:g}: must be a positive number of frames per second")
+    if not 0 < fps <= MAX_FPS:
+        fail(f"--fps {fps:g}: must be a number of frames per second above 0 and at most {MAX_FPS}")
     return fps
+
+
+MAX_FPS, SIZE_RANGE, WIDTH_RANGE, COLUMNS_RANGE, COUNT_RANGE = 1000, (32, 8192), (100, 16384), (1, 64), (1, 1000)
+
+
+def _bounded(option: str, low: int, high: int, what: str):
+    """A callback that refuses an integer option outside [low, high] in one line (exit 2)."""
+    def check(value):
+        if value is not None and not low <= value <= high:
+            fail(f"{option} {value}: must be {what} from {low} to {high}")
+        return value
+    return check
+
+
+def _check_speed(speed: float) -> float:
+    if not (0 < speed < float("inf")):
+        fail(f"--speed {speed:g}: must be a positive number of simulated seconds per second of video")
+    return speed
 
 
 FpsOpt = Annotated[float, typer.Option(
@@ -461,14 +479,17 @@ def animate(
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output file, .gif or .mp4 (default "
                                                 "RUN_DIR/animation.gif).", show_default=False)] = None,
     fps: FpsOpt = 25.0,
-    speed: Annotated[float, typer.Option("--speed", help="Simulated seconds per second of video.")] = 1.0,
+    speed: Annotated[float, typer.Option("--speed", callback=_check_speed,
+                                         help="Simulated seconds per second of video.")] = 1.0,
     start: Annotated[Optional[float], typer.Option("--start", help="First time shown, in seconds (default: 0).",
                                                    show_default=False)] = None,
     end: Annotated[Optional[float], typer.Option("--end", help="Last time shown, in seconds (default: the run's end).",
                                                  show_default=False)] = None,
     follow: FollowOpt = False,
     view: ViewOpt = None,
-    size: Annotated[int, typer.Option("--size", help="The picture's longer side, in pixels.")] = 640,
+    size: Annotated[int, typer.Option("--size", callback=_bounded("--size", *SIZE_RANGE, "a number of pixels"),
+                                      help=f"The picture's longer side, in pixels ({SIZE_RANGE[0]} to "
+                                           f"{SIZE_RANGE[1]}).")] = 640,
     quiet: QuietOpt = False,
 ) -> None:
     """Animate a run folder as a GIF or an MP4 (by --out's extension), with the scene's geometry drawn."""
@@ -483,15 +504,22 @@ def frames(
     times: Annotated[Optional[str], typer.Option("--times", help="Times to show in seconds, comma-separated, e.g. "
                                                  "0,0.5,1,2,3 (the nearest saved frames).",
                                                  show_default=False)] = None,
-    count: Annotated[Optional[int], typer.Option("--count", help="Or this many frames evenly spaced from start "
+    count: Annotated[Optional[int], typer.Option("--count", callback=_bounded("--count", *COUNT_RANGE,
+                                                                              "a number of frames"),
+                                                 help="Or this many frames evenly spaced from start "
                                                  "to end (default 6; a run with fewer saved frames shows them "
-                                                 "all).", show_default=False)] = None,
+                                                 "all; at most 1000).", show_default=False)] = None,
     overlay: Annotated[bool, typer.Option("--overlay", help="All frames on one view, fading from the first to "
                                                             "the last, instead of side by side.")] = False,
     follow: FollowOpt = False,
     view: ViewOpt = None,
-    columns: Annotated[Optional[int], typer.Option("--columns", help="Panels per row.", show_default=False)] = None,
-    width: Annotated[Optional[int], typer.Option("--width", help="Picture width in pixels.", show_default=False)] = None,
+    columns: Annotated[Optional[int], typer.Option("--columns", callback=_bounded("--columns", *COLUMNS_RANGE,
+                                                                                  "a number of panels"),
+                                                   help="Panels per row (1 to 64).", show_default=False)] = None,
+    width: Annotated[Optional[int], typer.Option("--width", callback=_bounded("--width", *WIDTH_RANGE,
+                                                                              "a number of pixels"),
+                                                 help="Picture width in pixels (100 to 16384).",
+                                                 show_default=False)] = None,
     quiet: QuietOpt = False,
 ) -> None:
     """One PNG of selected frames of a run, side by side or overlaid."""
