@@ -406,3 +406,16 @@ def test_picture_options_are_bounded(tmp_path):
         result = CliRunner().invoke(app, [args[0], str(folder), *args[1:]])
         assert result.exit_code == 2, (args, result.output)
         assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.output
+
+
+def test_a_sweep_point_resumes_its_unfinished_run(tmp_path):
+    from ropesim.scene.schema import scene_to_toml
+    from ropesim.sweep.points import run_point
+
+    scene = ropesim.load_scene(SCENE, ["integrator.t_end=3000"])
+    folder = tmp_path / "point"
+    simulate(scene, folder, stop=(lambda calls=[]: calls.append(1) or len(calls) > 2))
+    assert json.loads((folder / "manifest.json").read_text())["status"] == "interrupted"
+    assert run_point(scene_to_toml(scene), str(folder))["status"] == "completed"
+    simulate(scene, tmp_path / "clean")
+    assert_identical(folder, tmp_path / "clean")

@@ -357,7 +357,9 @@ def sweep(
 ) -> None:
     """Run a scene for every combination of --set values, in parallel; rerun, it resumes.
 
-    Exits 3 if any run did not complete (each is recorded with its error in results.csv), 130 if interrupted.
+    Exits 3 if any run did not complete (each is recorded with its error in results.csv); 130, 143 or 129
+    if stopped by Ctrl-C, SIGTERM or SIGHUP: no new run starts, the running ones stop at their next chunk and
+    keep their frames, results.csv is written, and a rerun continues the unfinished runs from their checkpoints.
     """
     from ..sweep.core import run_sweep
     from ..sweep.plan import SweepError
@@ -371,7 +373,9 @@ def sweep(
         typer.echo(f"{result.csv_path}: {len(result.rows)} runs ({result.ran} run now, {result.skipped} kept)"
                    + "".join(f"\n{path}" for path in result.plots))
     if result.interrupted:
-        fail(f"sweep interrupted; rerun the same command to finish it ({result.csv_path})", EXIT_INTERRUPTED)
+        fail(f"sweep interrupted{'' if result.stopped_by == 'SIGINT' else f' by {result.stopped_by}'}; rerun the "
+             f"same command to finish it (unfinished runs continue from their checkpoints) ({result.csv_path})",
+             exit_code(name=result.stopped_by))
     if result.failed:
         fail(f"{len(result.failed)} of {len(result.rows)} runs did not complete; see the error column of "
              f"{result.csv_path}", EXIT_BLEW_UP)
@@ -599,6 +603,21 @@ MethodsOpt = Annotated[Optional[str], typer.Option(
     show_default=False)]
 
 
+METHOD_NAMES = ("symplectic_euler", "verlet", "yoshida4", "pefrl", "rk4", "sdirk2")
+LADDER_WARN_STEPS = 1e9
+
+
+def _warn_ladder(scene, steps: dict[str, float], command: str) -> None:
+    """Warn (one line) before a ladder of a billion steps or more, with its estimated run time."""
+    from ..run import NS_PER_NODE_STEP
+
+    total = sum(steps.values())
+    if total >= LADDER_WARN_STEPS:
+        seconds = 1e-9 * scene.rope.nodes * sum(n * NS_PER_NODE_STEP.get(m, 1000.0) for m, n in steps.items())
+        typer.echo(f"ropesim: warning: {command}: about {total:.2g} steps in all, about {_duration(seconds)} of "
+                   f"computing; Ctrl-C stops it", err=True)
+
+
 def _methods(text: str | None) -> list[str] | None:
     from ..integrate.methods import METHODS
 
@@ -647,7 +666,16 @@ def accuracy(
     scene, _ = _load(scene_file, sets)
     names, ladder = _methods(methods), _numbers(dts, "--dts")
     folder = out if out is not None else Path("runs") / f"accuracy-{scene.name}"
-    report = accuracy_report(scene, names, ladder, repeats)
+    base = scene.integrator.dt
+    rungs = ladder or [base * f for f in (4, 2, 1, 0.5, 0.25, 0.125)]
+    t_end = scene.integrator.t_end
+    steps = {m: sum(t_end / dt for dt in rungs) * repeats for m in (names or METHOD_NAMES)}
+    steps["pefrl"] = steps.get("pefrl", 0) + 1.5 * t_end / (min(rungs) / 16)     # the reference
+    _warn_ladder(scene, steps, "accuracy")
+    try:
+        report = accuracy_report(scene, names, ladder, repeats)
+    except (KeyboardInterrupt, Stopped) as exc:
+        fail("accuracy interrupted; nothing written", exit_code(exc))
     try:
         folder.mkdir(parents=True, exist_ok=True)
         write_csv(report, folder / "accuracy.csv")
@@ -685,7 +713,12 @@ def stability(
     names, ladder = _methods(methods), _numbers(fractions, "--fractions")
     ks = _numbers(stiffness, "--k")
     folder = out if out is not None else Path("runs") / f"stability-{scene.name}"
-    result = stability_sweep(scene, names, ladder, ks, steps)
+    probes = (len(ladder or range(20)) + 20) * len(ks or [0])       # the ladder and about 20 bisection probes
+    _warn_ladder(scene, {m: probes * steps for m in (names or METHOD_NAMES)}, "stability")
+    try:
+        result = stability_sweep(scene, names, ladder, ks, steps)
+    except (KeyboardInterrupt, Stopped) as exc:
+        fail("stability interrupted; nothing written", exit_code(exc))
     try:
         write_sweep(result, folder)
         plot_sweep(result, folder / "stability.png")
