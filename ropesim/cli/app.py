@@ -394,7 +394,7 @@ ViewOpt = Annotated[Optional[str], typer.Option(
 
 def _check_fps(fps: float) -> float:
     if not 0 < fps <= MAX_FPS:
-        fail(f"--fps {fps:g}: must be a number of frames per second above 0 and at most {MAX_FPS}")
+        fail(f"--fps {fps:g}: must be a positive number of frames per second, at most {MAX_FPS}")
     return fps
 
 
