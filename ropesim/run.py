@@ -12,7 +12,7 @@ from __future__ import annotations
 import signal
 import threading
 import time
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -44,35 +44,73 @@ class RunOutcome:
     message: str = ""
     bad_node: int = -1
     stable_dt: float | None = None
-    ledger: np.ndarray | None = None       # (F, 3) cumulative drag loss, held-node work, box work [J] per frame
+    ledger: np.ndarray | None = None       # (F, C) cumulative flows [J] per frame (LEDGER_COLUMNS)
     energy0: float = 0.0                   # mechanical energy at t = 0 [J]
     force_evaluations: int = 0
+    signal: str = ""                       # the signal that interrupted the run (SIGINT, SIGTERM, SIGHUP)
+    integrator: Integrator | None = None
+
+
+STOP_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
+EXIT_CODES = {"SIGINT": 130, "SIGTERM": 143, "SIGHUP": 129}   # 128 + the signal's number, as shells report
+
+
+class StopFlag:
+    """Set by a stop signal (or by hand); remembers which signal came first."""
+
+    def __init__(self):
+        self._event = threading.Event()
+        self.signal = ""
+
+    def set(self, name: str = "SIGINT") -> None:
+        if not self._event.is_set():
+            self.signal = name
+        self._event.set()
+
+    def is_set(self) -> bool:
+        return self._event.is_set()
 
 
 @contextmanager
-def _interrupt_flag():
-    """While inside, Ctrl-C sets the returned flag instead of raising, so a chunk always finishes whole."""
-    flag = threading.Event()
+def stop_signals(flag: StopFlag | None = None):
+    """While inside, Ctrl-C (SIGINT), SIGTERM and SIGHUP set the returned flag instead of ending the process, so
+    a chunk always finishes whole and the run stops cleanly at the next one. Only the main thread can handle
+    signals; elsewhere (and after the block: a notebook keeps its own handlers) nothing is installed."""
+    flag = flag if flag is not None else StopFlag()
     if threading.current_thread() is not threading.main_thread():
         yield flag
         return
-    previous = signal.getsignal(signal.SIGINT)
-    signal.signal(signal.SIGINT, lambda *_: flag.set())
+    previous = {}
     try:
+        for sig in STOP_SIGNALS:
+            previous[sig] = signal.signal(sig, lambda signum, _frame: flag.set(signal.Signals(signum).name))
         yield flag
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+_interrupt_flag = stop_signals  # the former name
 
 
 def integrate(model: Model, store, on_progress: Callable[[float, float], None] | None = None,
-              target_chunk_seconds: float = 0.1, stop: Callable[[], bool] | None = None) -> RunOutcome:
-    """Step ``model`` from t = 0 to t_end, appending saved frames to ``store`` (see :class:`FrameStore`)."""
+              target_chunk_seconds: float = 0.1, stop: Callable[[], bool] | None = None,
+              integrator: Integrator | None = None, interrupted: StopFlag | None = None,
+              on_chunk: Callable[[Integrator, float], None] | None = None) -> RunOutcome:
+    """Step ``model`` to t_end, appending saved frames to ``store`` (see :class:`FrameStore`).
+
+    From t = 0, or from where ``integrator`` (restored from a checkpoint) stands. ``on_chunk(integrator,
+    seconds)`` is called after the first frame and after every chunk (a run folder commits checkpoints there).
+    """
     scene = model.scene
-    grid = TimeGrid.of(scene)
-    with _interrupt_flag() as interrupted:  # a Ctrl-C while compiling stops the run cleanly at t = 0
-        integrator = make_integrator(model, grid)
-        store.append(np.zeros(1), integrator.x[None], integrator.v[None])
-        ledger = [np.zeros((1, len(LEDGER_COLUMNS)))]
+    grid = TimeGrid.of(scene) if integrator is None else integrator.grid
+    with (nullcontext(interrupted) if interrupted is not None else stop_signals()) as flag:
+        if integrator is None:
+            integrator = make_integrator(model, grid)
+        if integrator.step == 0 and store.count == 0:
+            store.append(np.zeros(1), integrator.x[None], integrator.v[None], np.zeros((1, len(LEDGER_COLUMNS))))
+            if on_chunk is not None:
+                on_chunk(integrator, 0.0)
         status, bad_node, message, code = "completed", -1, "", OK
         chunk = max(1, min(grid.steps, 20_000_000 // max(1, model.nodes * integrator.method.evaluations)))
         chunk = _round_to(chunk, grid.save_every)
@@ -80,7 +118,7 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
         compile_time = integrator.warm_up()
         start = time.perf_counter()
         while integrator.step < grid.steps:
-            if interrupted.is_set() or (stop is not None and stop()):
+            if flag.is_set() or (stop is not None and stop()):
                 status = INTERRUPTED
                 message = f"interrupted at t = {integrator.t:.6g} s (step {integrator.step} of {grid.steps})"
                 break
@@ -89,16 +127,19 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
             tick = time.perf_counter()
             done, written, code, node = integrator.advance(n, frames)
             elapsed = time.perf_counter() - tick
-            store.append(frames[0][:written], frames[1][:written], frames[2][:written])
-            ledger.append(frames[3][:written])
+            store.append(frames[0][:written], frames[1][:written], frames[2][:written], frames[3][:written])
             if code != OK:
                 status, bad_node = BLEW_UP, node
                 break
+            if on_chunk is not None:
+                on_chunk(integrator, time.perf_counter() - start)
             if on_progress is not None:
                 on_progress(integrator.t, scene.integrator.t_end)
             if elapsed > 0:
                 rate = done / elapsed
                 chunk = _round_to(max(1, int(rate * target_chunk_seconds)), grid.save_every)
+        if hasattr(store, "drain"):
+            store.drain()       # the frames still being written count in the run's wall time
     wall = time.perf_counter() - start
 
     stable_dt = None
@@ -107,8 +148,27 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
 
     return RunOutcome(status=status, steps=integrator.step, t_reached=integrator.t, wall_time=wall,
                       compile_time=compile_time, grid=grid, message=message, bad_node=bad_node, stable_dt=stable_dt,
-                      ledger=np.concatenate(ledger), energy0=float(integrator.ledger[E0]),
-                      force_evaluations=integrator.force_evaluations)
+                      ledger=store.arrays()["ledger"], energy0=float(integrator.ledger[E0]),
+                      force_evaluations=integrator.force_evaluations,
+                      signal=flag.signal if status == INTERRUPTED and flag.is_set() else "", integrator=integrator)
+
+
+def advance_in_chunks(integrator: Integrator, steps: int, target_chunk_seconds: float = 0.1):
+    """``integrator.advance(steps)`` cut into chunks of about ``target_chunk_seconds`` (the numbers are the
+    same however it is cut), so that Ctrl-C or SIGTERM are honoured within a chunk instead of after the whole
+    run. Returns the last chunk's Advance with ``done`` summed; stops at the first bad status."""
+    done, chunk, result = 0, min(steps, 1000), None
+    while done < steps or result is None:
+        n = min(chunk, steps - done)
+        tick = time.perf_counter()
+        result = integrator.advance(n)
+        elapsed = time.perf_counter() - tick
+        done += result.done
+        if result.status != OK or n == 0:
+            break
+        if elapsed > 0:
+            chunk = max(1, int(result.done / elapsed * target_chunk_seconds))
+    return result._replace(done=done)
 
 
 def _sharp_contacts(scene: Scene) -> bool:
@@ -147,41 +207,279 @@ def _round_to(n: int, multiple: int) -> int:
     return max(multiple, (n // multiple) * multiple)
 
 
-def simulate(scene: Scene, folder: str | Path | None = None, progress: bool = False):
+# Measured cost of the kernel per node and step [ns] (helicopter_mass at 21 and 201 nodes, the larger of the
+# two; scripts/bench_runfolder.py --costs), and of deriving and writing a saved frame per node [ns].
+NS_PER_NODE_STEP = {"symplectic_euler": 4.2, "verlet": 6.2, "yoshida4": 19.0, "pefrl": 20.0, "rk4": 180.0,
+                    "sdirk2": 1100.0}
+NS_PER_NODE_FRAME = 150.0
+WARN_BYTES = 2 * 10 ** 9        # `run` and `check` warn above this much output
+WARN_SECONDS = 15 * 60          # ... or this long a run
+
+
+@dataclass
+class Estimate:
+    """What a run will take before it starts: its frames, their bytes (the run folder's finished size; while
+    it finishes, the checkpoint streams and trajectory.npz exist together: ``peak_bytes``) and its run time."""
+
+    frames: int
+    bytes: int
+    peak_bytes: int
+    seconds: float
+
+
+def estimate(scene: Scene, model: Model | None = None) -> Estimate:
+    """The output size and run time of ``scene``, from its time grid and the method's measured cost."""
+    model = model if model is not None else build(scene)
+    grid = TimeGrid.of(scene)
+    row = 8 * sum(int(np.prod(s, dtype=np.int64)) for s in frame_specs(model).values())
+    total = grid.frames * row
+    cost = NS_PER_NODE_STEP.get(scene.integrator.method, max(NS_PER_NODE_STEP.values()))
+    seconds = 1e-9 * model.nodes * (grid.steps * cost + grid.frames * NS_PER_NODE_FRAME)
+    return Estimate(frames=grid.frames, bytes=total, peak_bytes=2 * total, seconds=seconds)
+
+
+CHECKPOINT_SECONDS = 5.0   # a run folder commits a checkpoint at most this often (and at every stop)
+
+
+def frame_specs(model: Model) -> dict[str, tuple]:
+    """The named per-frame arrays a run stores and their per-frame shapes: t, x, v, what
+    :func:`ropesim.model.tension.frame_arrays` derives (tension, strain, support forces), and the ledger's
+    flows."""
+    from .model.tension import frame_shapes
+
+    return {"t": (), "x": (model.nodes, model.dim), "v": (model.nodes, model.dim), **frame_shapes(model),
+            "ledger": (len(LEDGER_COLUMNS),)}
+
+
+def simulate(scene: Scene, folder: str | Path | None = None, progress: bool = False, *,
+             stop: Callable[[], bool] | None = None, checkpoint_seconds: float = CHECKPOINT_SECONDS):
     """Run ``scene`` and return its :class:`~ropesim.trajectory.Trajectory`.
 
-    With ``folder`` the run also writes ``trajectory.npz``, ``scene.toml`` and ``summary.json`` there, each
-    atomically; frames stream to disk as they are computed. A run that blows up or is interrupted stops
-    cleanly: the trajectory holds every frame up to that point and ``summary["status"]`` says what happened.
+    With ``folder`` the run is written there as a transaction (:mod:`ropesim.io.runfolder`): frames stream to
+    disk in durable checkpoints, and at the end ``trajectory.npz``, ``ledger.npz`` and ``summary.json`` are
+    written and committed by ``manifest.json``. An earlier run in the folder is replaced whole; a folder
+    another process is writing is refused (:class:`~ropesim.io.runfolder.RunFolderBusy`). A run that blows up
+    or is interrupted (Ctrl-C, SIGTERM, SIGHUP, or ``stop()`` returning True) stops cleanly: the trajectory
+    holds every frame up to that point and ``summary["status"]`` says what happened; an interrupted run
+    continues with :func:`resume`.
     """
-    from .analysis.ledger import write_ledger
-    from .analysis.summary import summarize
+    from .io.runfolder import RunWriter
     from .scene.schema import scene_to_toml
-    from .io.trajectory import SCENE, SUMMARY, FrameStore, Trajectory, write_json_atomic, write_text_atomic
 
     model = build(scene)
     grid = TimeGrid.of(scene)
-    folder = Path(folder) if folder is not None else None
-    from .model.tension import frame_arrays, frame_shapes
+    if folder is None:
+        return _run_in_memory(model, grid, progress, stop)
+    writer = RunWriter.create(Path(folder), scene_to_toml(scene), frame_specs(model), _manifest_info(scene, grid))
+    return _run_in_folder(model, grid, writer, None, {}, progress, stop, checkpoint_seconds)
 
-    store = FrameStore(grid.frames, model.nodes, model.dim, folder,
-                       derive=lambda t, x, v: frame_arrays(model, t, x, v), shapes=frame_shapes(model))
+
+def resume(folder: str | Path, t_end: float | None = None, progress: bool = False, *,
+           stop: Callable[[], bool] | None = None, checkpoint_seconds: float = CHECKPOINT_SECONDS):
+    """Continue the run in ``folder`` from its last checkpoint; with ``t_end``, extend it (a finished run too).
+
+    The result is bit for bit the run that was never stopped: frames, ledger, tension and summary (but for
+    wall times). Refused in one line (:class:`~ropesim.io.runfolder.RunFolderError`) when there is nothing to
+    continue, when scene.toml was edited since, or when the new t_end would change the time grid.
+    """
+    from dataclasses import replace
+
+    from .io.runfolder import (BLEW_UP as BLEW, COMPLETED as DONE, SCENE, RunFolderError, RunWriter, scene_hash)
+    from .scene.loader import SceneError, scene_from_toml
+    from .scene.schema import scene_to_toml
+
+    folder = Path(folder)
+    writer = RunWriter.reopen(folder)
     try:
-        if folder is not None:
-            write_text_atomic(folder / SCENE, scene_to_toml(scene))
-        with _progress(progress, scene) as on_progress:
-            outcome = integrate(model, store, on_progress)
-        arrays = store.arrays()
-        summary = summarize(model, outcome, arrays["t"], arrays["x"], arrays["v"], arrays["tension"])
-        if folder is not None:
-            write_ledger(folder, arrays["t"], outcome.ledger, outcome.energy0)
-            store.finish()
-            write_json_atomic(folder / SUMMARY, summary)
-            return Trajectory.open(folder)
-        return Trajectory(t=arrays["t"], x=arrays["x"], v=arrays["v"], scene=scene, summary=summary,
-                          tension=arrays["tension"], strain=arrays["strain"], support=arrays.get("support"))
+        m = writer.manifest
+        try:
+            text = (folder / SCENE).read_text(encoding="utf-8")
+            scene = scene_from_toml(text, source=str(folder / SCENE))
+        except (OSError, SceneError) as exc:
+            raise RunFolderError(f"{folder / SCENE}: cannot be read ({exc}); run the scene again") from None
+        if scene_hash(text) != m.get("scene_sha256"):
+            raise RunFolderError(f"{folder / SCENE}: changed since the run began, so the run cannot continue bit "
+                                 f"for bit; run the scene again (only --set integrator.t_end=... may change with "
+                                 f"--resume)")
+        old_t_end = scene.integrator.t_end
+        if t_end is not None and t_end != old_t_end:
+            scene = replace(scene, integrator=replace(scene.integrator, t_end=float(t_end)))
+        if m["status"] == BLEW:
+            raise RunFolderError(f"{folder}: blew up ({m.get('message', '')}); it cannot continue; run it again "
+                                 f"with a smaller integrator.dt")
+        if m["status"] == DONE and scene.integrator.t_end <= old_t_end:
+            raise RunFolderError(f"{folder}: already completed to t = {old_t_end:g} s; to extend it give "
+                                 f"--set integrator.t_end=T with T > {old_t_end:g}")
+        model = build(scene)
+        grid = TimeGrid.of(scene)
+        old = m.get("grid", {})
+        if (grid.dt, grid.save_every) != (old.get("dt"), old.get("save_every")):
+            raise RunFolderError(
+                f"{folder}: integrator.t_end = {scene.integrator.t_end:g} s changes the run's time grid (dt "
+                f"{old.get('dt')!r} -> {grid.dt!r} s, a frame every {old.get('save_every')} -> {grid.save_every} "
+                f"steps), so the result could not equal one uninterrupted run; choose t_end a whole number of "
+                f"dt = {old.get('dt')!r} s")
+        specs = frame_specs(model)
+        state, cp = writer.load_checkpoint(specs)
+        step = int(state["step"])
+        if step > grid.steps:
+            raise RunFolderError(f"{folder}: its last checkpoint is at t = {cp['t']:.6g} s, past the new t_end")
+        on_grid = 1 + step // grid.save_every + (1 if step == grid.steps and step % grid.save_every else 0)
+        if writer.count > on_grid:      # the shorter run's own last frame, off the longer run's grid
+            writer.drop_last_frames(on_grid)
+        elif writer.count != on_grid:
+            raise RunFolderError(f"{folder}: its checkpoint holds {writer.count} frames for step {step}, expected "
+                                 f"{on_grid}; run the scene again")
+        if scene.integrator.t_end != old_t_end:
+            new_text = scene_to_toml(scene)
+            from .io.trajectory import write_text_atomic
+
+            write_text_atomic(folder / SCENE, new_text)
+            m.update(_manifest_info(scene, grid), scene_sha256=scene_hash(new_text))
+        integrator = make_integrator(model, grid)
+        integrator.restore(state)
+        return _run_in_folder(model, grid, writer, integrator, cp, progress, stop, checkpoint_seconds)
+    except BaseException:
+        writer.close()
+        raise
+
+
+def _manifest_info(scene: Scene, grid: TimeGrid) -> dict:
+    return {"scene": scene.name, "grid": {"dt": grid.dt, "steps": grid.steps, "save_every": grid.save_every,
+                                          "frames": grid.frames, "t_end": scene.integrator.t_end}}
+
+
+def _run_in_memory(model: Model, grid: TimeGrid, progress: bool, stop) -> "Trajectory":
+    from .analysis.summary import summarize
+    from .io.trajectory import FrameStore, Trajectory
+    from .model.tension import frame_arrays
+
+    specs = frame_specs(model)
+    store = FrameStore(grid.frames, model.nodes, model.dim, derive=lambda t, x, v: frame_arrays(model, t, x, v),
+                       shapes={k: s for k, s in specs.items() if k not in ("t", "x", "v", "ledger")})
+    with _progress(progress, model.scene) as on_progress:
+        outcome = integrate(model, store, on_progress, stop=stop)
+    arrays = store.arrays()
+    summary = summarize(model, outcome, arrays["t"], arrays["x"], arrays["v"], arrays["tension"])
+    _stopped_by(summary, outcome)
+    extra = {k: v for k, v in arrays.items() if k in ("tension", "strain", "support", "ledger")}
+    return Trajectory(t=arrays["t"], x=arrays["x"], v=arrays["v"], scene=model.scene, summary=summary, **extra)
+
+
+def _stopped_by(summary: dict, outcome: RunOutcome) -> None:
+    if outcome.signal:
+        summary["stopped_by"] = outcome.signal
+
+
+class _DiskStore:
+    """The integration loop's frame store for a run folder. Frames are derived (tension, strain) and written
+    by a background thread while the kernel computes the next chunk; a checkpoint waits for it, then commits
+    (at most every ``seconds`` of wall time, and at every stop)."""
+
+    DEPTH = 2   # chunks waiting to be written at most (each at most FRAME_BUFFER_BYTES of frames)
+
+    def __init__(self, writer, model: Model, seconds: float, previous: dict):
+        import queue
+
+        from .io.trajectory import FrameStore
+        from .model.tension import frame_arrays
+
+        self.writer, self.seconds = writer, seconds
+        self.rows = FrameStore(0, model.nodes, model.dim, derive=lambda t, x, v: frame_arrays(model, t, x, v)).rows
+        self.last = -float("inf")
+        self.wall0 = float(previous.get("wall_time_s", 0.0))
+        self.compile0 = float(previous.get("compile_time_s", 0.0))
+        self.compile_time = 0.0
+        self.error: BaseException | None = None
+        self.queue: queue.Queue = queue.Queue(maxsize=self.DEPTH)
+        self.thread = threading.Thread(target=self._work, name="ropesim-frame-writer", daemon=True)
+        self.thread.start()
+
+    def _work(self) -> None:
+        while True:
+            item = self.queue.get()
+            try:
+                if item is None:
+                    return
+                if self.error is None:
+                    self.writer.append(self.rows(*item))
+            except BaseException as exc:   # handed to the main thread at its next append or checkpoint
+                self.error = exc
+            finally:
+                self.queue.task_done()
+
+    def _raise(self) -> None:
+        if self.error is not None:
+            error, self.error = self.error, None
+            raise error
+
+    def append(self, t, x_dn, v_dn, ledger=None) -> None:
+        self._raise()
+        if len(t):
+            self.queue.put((t, x_dn, v_dn, ledger))
+
+    def drain(self) -> None:
+        self.queue.join()
+        self._raise()
+
+    def close(self) -> None:
+        if self.thread.is_alive():
+            self.queue.put(None)
+            self.thread.join()
+
+    @property
+    def count(self) -> int:
+        self.drain()
+        return self.writer.count
+
+    def arrays(self) -> dict:
+        self.drain()
+        return self.writer.arrays()
+
+    def on_chunk(self, integrator: Integrator, wall: float) -> None:
+        self._raise()
+        if time.monotonic() - self.last >= self.seconds:
+            self.checkpoint(integrator, wall)
+
+    def checkpoint(self, integrator: Integrator, wall: float) -> None:
+        self.drain()
+        self.writer.checkpoint(integrator.state(), integrator.step, integrator.t,
+                               extra={"wall_time_s": self.wall0 + wall,
+                                      "compile_time_s": self.compile0 + self.compile_time})
+        self.last = time.monotonic()
+
+
+def _run_in_folder(model: Model, grid: TimeGrid, writer, integrator: Integrator | None, previous: dict,
+                   progress: bool, stop, checkpoint_seconds: float):
+    from .analysis.ledger import ledger_arrays
+    from .analysis.summary import summarize
+    from .io.runfolder import LEDGER, TRAJECTORY
+    from .io.trajectory import Trajectory
+
+    folder = writer.folder
+    writer.expected_frames = grid.frames
+    store = _DiskStore(writer, model, checkpoint_seconds, previous)
+    try:
+        with stop_signals() as flag, _progress(progress, model.scene) as on_progress:
+            outcome = integrate(model, store, on_progress, stop=stop, integrator=integrator, interrupted=flag,
+                                on_chunk=store.on_chunk)
+            store.compile_time = outcome.compile_time
+            store.checkpoint(outcome.integrator, outcome.wall_time)     # every stop is a checkpoint
+            outcome.wall_time += store.wall0
+            outcome.compile_time += store.compile0
+            arrays = writer.arrays()
+            summary = summarize(model, outcome, arrays["t"], arrays["x"], arrays["v"], arrays["tension"])
+            _stopped_by(summary, outcome)
+            if outcome.status == INTERRUPTED:
+                writer.mark(INTERRUPTED, outcome.message, summary)
+            else:
+                files = {TRAJECTORY: {k: a for k, a in arrays.items() if k != "ledger"},
+                         LEDGER: ledger_arrays(arrays["t"], arrays["ledger"], outcome.energy0)}
+                writer.finish(outcome.status, outcome.integrator.state(), files, summary, outcome.message)
     finally:
-        store.discard()
+        store.close()
+        writer.close()
+    return Trajectory.open(folder, verify=False)
 
 
 @contextmanager

@@ -85,8 +85,8 @@ def test_run_writes_exactly_the_run_folder(runs, name):
     assert result.stderr == ""
     assert f"{name}: completed" in result.stdout and str(folder) in result.stdout
     names = {p.name for p in folder.iterdir()}
-    assert {"scene.toml", "summary.json", "trajectory.npz"} <= names
-    # atomic writes leave no temporary files or streamed-frame folders (.frames-*) behind
+    assert names == {"scene.toml", "summary.json", "trajectory.npz", "ledger.npz", "manifest.json", "state.npz"}
+    # atomic writes leave no temporary files, checkpoint streams or lock behind
     assert not [n for n in names if n.startswith(".") or n.endswith(".tmp")], names
 
 

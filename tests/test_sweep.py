@@ -305,7 +305,7 @@ def test_ctrl_c_stops_the_runs_cleanly_and_the_table_says_so(tmp_path):
     proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         deadline = time.monotonic() + 180
-        while len(list(out.glob("*/.frames-*"))) < 2:  # both runs are streaming frames: they are integrating
+        while sum(f.stat().st_size > 4096 for f in out.glob("*/checkpoint/x.npy")) < 2:  # both are integrating
             assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
             time.sleep(0.2)
         time.sleep(0.5)
@@ -322,4 +322,59 @@ def test_ctrl_c_stops_the_runs_cleanly_and_the_table_says_so(tmp_path):
         assert row["error"].startswith("interrupted at t = ")
         traj = ropesim.Trajectory.open(out / row["run"])
         assert traj.t[-1] < 1e6 and np.all(np.isfinite(traj.x))  # the frames up to the stop, kept
-        assert not list((out / row["run"]).glob(".frames-*"))  # streaming files cleaned up
+        assert (out / row["run"] / "checkpoint").is_dir()  # kept for the rerun to resume
+
+
+def _children(pid: int) -> list[int]:
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            out.append(int(stat.parent.name))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.slow
+def test_sigterm_stops_the_sweep_writes_the_table_and_leaves_no_process(tmp_path):
+    """SIGTERM to the sweep alone (as `timeout` or a batch scheduler sends it): exit 143, the running runs stop
+    at their next chunk keeping their checkpoints, no run starts after it, results.csv is written, and no
+    worker process is left behind."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "sweep"
+    cmd = [sys.executable, "-m", "ropesim", "sweep", str(UNIFORM), "--out", str(out), "-j", "2",
+           "--set", "drag.b=4,5,6,7", "--set", "integrator.t_end=1e6", "--set", "output.interval=10"]
+    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 180
+        while sum(f.stat().st_size > 4096 for f in out.glob("*/checkpoint/x.npy")) < 2:
+            assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+            time.sleep(0.2)
+        workers = _children(proc.pid)
+        started = time.monotonic()
+        proc.send_signal(signal.SIGTERM)
+        _, stderr = proc.communicate(timeout=120)
+        took = time.monotonic() - started
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 143, stderr
+    assert "sweep interrupted by SIGTERM" in stderr and took < 30
+    rows = read_table(out / "results.csv")
+    assert sorted(r["status"] for r in rows) == ["error", "error", "interrupted", "interrupted"]
+    assert all(r["error"].startswith("not run") for r in rows if r["status"] == "error")
+    time.sleep(0.5)
+    assert workers and not [pid for pid in workers if _alive(pid)], "worker processes left behind"

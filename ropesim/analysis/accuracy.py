@@ -97,6 +97,7 @@ def run_once(scene: Scene, method: str, dt: float, repeats: int = 1, exact_conta
     from ..integrate.health import net_flow
     from ..integrate.methods import make_integrator
     from ..model.energy import energy_terms
+    from ..run import advance_in_chunks
 
     scene = single_frame(scene, dt, method)
     model = build(scene)
@@ -108,7 +109,7 @@ def run_once(scene: Scene, method: str, dt: float, repeats: int = 1, exact_conta
             stepper.set_exact_contacts(exact_contacts)
         stepper.warm_up()
         start = time.perf_counter()
-        _, _, status, _ = stepper.advance(grid.steps)
+        _, _, status, _ = advance_in_chunks(stepper, grid.steps)   # Ctrl-C is honoured between chunks
         times.append(time.perf_counter() - start)
         if status != OK:
             break

@@ -32,14 +32,19 @@ GAINS = ("held_work", "box_work", "fluid_work", "internal_work", "seabed_work") 
 LOSSES = ("drag_loss",)                                                           # energy taken out [J]
 
 
+def ledger_arrays(t: np.ndarray, flows: np.ndarray, energy0: float) -> dict[str, np.ndarray]:
+    """The arrays of ``ledger.npz``: ``t``, one array per column of the cumulative flows (F, C), ``energy0``."""
+    arrays = {"t": np.asarray(t)[:len(flows)]}
+    arrays.update({name: np.ascontiguousarray(flows[:, c]) for c, name in enumerate(LEDGER_COLUMNS)})
+    arrays["energy0"] = np.array(energy0)
+    return arrays
+
+
 def write_ledger(folder: Path, t: np.ndarray, flows: np.ndarray, energy0: float) -> None:
     """Write ``ledger.npz`` atomically: the cumulative flows (F, C) at the saved frames' times."""
     from ..io.trajectory import write_npz_atomic
 
-    arrays = {"t": np.asarray(t)[:len(flows)]}
-    arrays.update({name: np.ascontiguousarray(flows[:, c]) for c, name in enumerate(LEDGER_COLUMNS)})
-    arrays["energy0"] = np.array(energy0)
-    write_npz_atomic(Path(folder) / LEDGER, arrays)
+    write_npz_atomic(Path(folder) / LEDGER, ledger_arrays(t, flows, energy0))
 
 
 def read_flows(folder: Path) -> tuple[np.ndarray, float] | None:

@@ -200,6 +200,7 @@ def probe(scene, method: str, dt: float, steps: int = PROBE_STEPS) -> bool:
     from ..integrate.methods import make_integrator
     from ..model.build import build
     from ..model.energy import energy_terms
+    from ..run import advance_in_chunks
 
     integ = dataclasses.replace(scene.integrator, method=method, dt=dt, t_end=steps * dt)
     out = dataclasses.replace(scene.output, interval=steps * dt)
@@ -210,7 +211,7 @@ def probe(scene, method: str, dt: float, steps: int = PROBE_STEPS) -> bool:
     model.x0[:, free] += PERTURBATION * scene.rope.segment_length * rng.standard_normal((model.dim, free.sum()))
     grid = TimeGrid.of(scene)
     stepper = make_integrator(model, grid, method)
-    _, _, status, _ = stepper.advance(grid.steps)
+    _, _, status, _ = advance_in_chunks(stepper, grid.steps)   # Ctrl-C is honoured between chunks
     if status != OK:
         return False
     ledger = stepper.ledger

@@ -1,8 +1,8 @@
 """The command line. Each command parses its options and calls one function elsewhere.
 
 Bad input (a scene file, a --set, a run folder) prints one line naming the file, the key and what is
-allowed, and exits with code 2; a run that blows up exits 3; an interrupted run exits 130. Both keep what
-they computed.
+allowed, and exits with code 2; a run that blows up exits 3; a run folder that cannot be written (a full
+disk) exits 4; a run stopped by Ctrl-C, SIGTERM or SIGHUP exits 130, 143 or 129. All keep what they computed.
 """
 
 from __future__ import annotations
@@ -60,7 +60,18 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     context_settings={"help_option_names": ["-h", "--help"]},
 )
-EXIT_BAD_INPUT, EXIT_BLEW_UP, EXIT_INTERRUPTED = 2, 3, 130
+EXIT_BAD_INPUT, EXIT_BLEW_UP, EXIT_WRITE, EXIT_INTERRUPTED = 2, 3, 4, 130
+SIGNAL_EXIT = {"SIGINT": 130, "SIGTERM": 143, "SIGHUP": 129}   # 128 + the signal's number, as a shell reports
+
+
+from ..stop import Stopped  # noqa: E402
+
+
+def exit_code(exc: BaseException | None = None, name: str = "") -> int:
+    """The exit code of a stop: by the signal's name, or the Stopped exception that carries one."""
+    if isinstance(exc, Stopped):
+        name = exc.name
+    return SIGNAL_EXIT.get(name, EXIT_INTERRUPTED)
 
 SceneArg = Annotated[str, typer.Argument(
     metavar="SCENE", help="A scene file (TOML), or the name of a built-in scene such as helicopter_mass "
@@ -115,39 +126,126 @@ def _load(scene: str, sets: list[str] | None):
 
 @app.command(cls=Command)
 def run(
-    scene_file: SceneArg,
-    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Run folder (default runs/<scene name>/).",
+    scene_file: Annotated[Optional[str], typer.Argument(
+        metavar="SCENE", help="A scene file (TOML), or the name of a built-in scene such as helicopter_mass "
+                              "(`ropesim scenarios` lists them); not with --resume.", show_default=False)] = None,
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Run folder (default runs/<scene name>/). An "
+                                                "earlier run there is replaced whole, pictures included.",
                                                 show_default=False)] = None,
     sets: SetOpt = None,
+    resume: Annotated[Optional[Path], typer.Option(
+        "--resume", metavar="RUN_DIR", help="Continue the interrupted or killed run in RUN_DIR from its last "
+                                            "checkpoint, bit for bit as if it had never stopped; with --set "
+                                            "integrator.t_end=T, extend it (a finished run too).",
+        show_default=False)] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")] = False,
     animate_: Annotated[bool, typer.Option("--animate", help="Then animate the run into RUN_FOLDER/animation.gif "
                                                              "(more choices: `ropesim animate`).")] = False,
     fps: FpsOpt = 25.0,
     force: Annotated[bool, typer.Option("--force", help="Run even when dt is above the method's stability bound "
-                                                        "(see `ropesim check`).")] = False,
+                                                        "(see `ropesim check`) or the disk looks too small for "
+                                                        "the frames.")] = False,
 ) -> None:
-    """Run a scene and write trajectory.npz, scene.toml and summary.json into its run folder."""
+    """Run a scene and write trajectory.npz, ledger.npz, scene.toml and summary.json into its run folder.
+
+    Frames stream to the folder in checkpoints; Ctrl-C, SIGTERM or SIGHUP stop the run at its next chunk and
+    keep them, and `ropesim run --resume RUN_DIR` continues it.
+    """
     from .report import print_summary
+    from ..io.runfolder import DiskFull, RunFolderError
     from ..run import BLEW_UP, INTERRUPTED, simulate
 
-    scene, where = _load(scene_file, sets)
-    _check_time_step(scene, where, force, quiet)
-    folder = out if out is not None else Path("runs") / scene.name
-    if folder.exists() and not folder.is_dir():
-        fail(f"--out {folder}: exists and is not a folder")
+    progress = not quiet and sys.stderr.isatty()
+    if resume is not None:
+        if scene_file is not None or out is not None:
+            fail("--resume RUN_DIR continues the run in RUN_DIR: give no SCENE and no --out with it")
+        folder, where = resume, str(resume)
+        t_end = _resume_t_end(sets)
+        run_it = (lambda: _resume(folder, t_end, progress))
+    else:
+        if scene_file is None:
+            fail("missing SCENE: a scene file or a built-in scene's name (or --resume RUN_DIR)")
+        scene, where = _load(scene_file, sets)
+        _check_time_step(scene, where, force, quiet)
+        folder = out if out is not None else Path("runs") / scene.name
+        if folder.exists() and not folder.is_dir():
+            fail(f"--out {folder}: exists and is not a folder")
+        blocked = next((p for p in folder.parents if p.exists() and not p.is_dir()), None)
+        if blocked is not None:
+            fail(f"--out {folder}: cannot write the run folder: {blocked} is a file, not a folder")
+        _check_size(scene, where, folder, force, quiet)
+        run_it = (lambda: simulate(scene, folder, progress=progress))
     try:
-        traj = simulate(scene, folder, progress=not quiet and sys.stderr.isatty())
+        traj = run_it()
+    except DiskFull as exc:
+        fail(str(exc), EXIT_WRITE)
+    except RunFolderError as exc:
+        fail(str(exc))
     except OSError as exc:
-        fail(f"{folder}: cannot write the run folder ({exc.strerror or exc})")
+        fail(f"{folder}: cannot write the run folder ({exc.strerror or exc})", EXIT_WRITE)
     summary = traj.summary
     if not quiet:
         print_summary(summary, folder)
     if summary["status"] == BLEW_UP:
         fail(f"{where}: {summary['message']}; frames up to then are in {folder}", EXIT_BLEW_UP)
     if summary["status"] == INTERRUPTED:
-        fail(f"{where}: {summary['message']}; frames up to then are in {folder}", EXIT_INTERRUPTED)
+        by = summary.get("stopped_by", "SIGINT")
+        fail(f"{where}: {summary['message']}" + (f" by {by}" if by != "SIGINT" else "")
+             + f"; frames up to then are in {folder}; `ropesim run --resume {folder}` continues it",
+             exit_code(name=by))
     if animate_:
         _animate(folder, None, quiet, fps=fps)
+
+
+def _resume_t_end(sets: list[str] | None) -> float | None:
+    """The new t_end of ``--resume --set integrator.t_end=T``; any other --set is refused."""
+    t_end = None
+    for item in sets or []:
+        key, _, value = item.partition("=")
+        if key.strip() != "integrator.t_end":
+            fail(f"--set {item}: with --resume only integrator.t_end may change (the rest of the scene is the "
+                 f"run's own scene.toml)")
+        try:
+            t_end = float(value)
+        except ValueError:
+            t_end = float("nan")
+        if not (t_end >= 0 and t_end < float("inf")):
+            fail(f"--set {item}: integrator.t_end must be a number of seconds >= 0")
+    return t_end
+
+
+def _resume(folder: Path, t_end: float | None, progress: bool):
+    from ..run import resume
+
+    return resume(folder, t_end, progress=progress)
+
+
+def _check_size(scene, where: str, folder: Path, force: bool, quiet: bool) -> None:
+    """Warn when the output or the run time is large; refuse (exit 2) unless --force when the disk cannot
+    hold the frames."""
+    from ..io.runfolder import free_bytes, human
+    from ..run import WARN_BYTES, WARN_SECONDS, estimate
+
+    est = estimate(scene)
+    free = free_bytes(folder)
+    if est.peak_bytes > free and not force:
+        fail(f"{where}: the run would write about {human(est.bytes)} of frames ({est.frames:,} frames; "
+             f"{human(est.peak_bytes)} while it finishes) and {folder} has {human(free)} free; raise "
+             f"output.interval, shorten integrator.t_end, choose another --out, or --force to run anyway")
+    if not quiet and (est.bytes > WARN_BYTES or est.seconds > WARN_SECONDS):
+        typer.echo(f"ropesim: warning: {where}: a large run: about {human(est.bytes)} of frames ({est.frames:,} "
+                   f"frames) and about {_duration(est.seconds)} of computing; Ctrl-C stops it cleanly and "
+                   f"`ropesim run --resume` continues it", err=True)
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.0f} min"
+    if seconds < 2 * 86400:
+        return f"{seconds / 3600:.1f} h"
+    return f"{seconds / 86400:.0f} days"
 
 
 def _check_time_step(scene, where: str, force: bool, quiet: bool) -> None:
@@ -172,8 +270,21 @@ def check(scene_file: SceneArg, sets: SetOpt = None) -> None:
     """Validate a scene and show what it contains and its stability bound, without running it."""
     from .report import print_check
 
+    from ..io.runfolder import free_bytes, human
+    from ..run import WARN_BYTES, WARN_SECONDS, estimate
+
     scene, where = _load(scene_file, sets)
     print_check(scene, where)
+    est, folder = estimate(scene), Path("runs") / scene.name
+    free = free_bytes(folder)
+    typer.echo(f"output: about {human(est.bytes)} in {est.frames:,} frames ({human(est.peak_bytes)} while the "
+               f"run finishes; {human(free)} free at {folder}); run time about {_duration(est.seconds)}")
+    if est.peak_bytes > free:
+        typer.echo(f"ropesim: warning: {where}: the disk at {folder} cannot hold the frames; `ropesim run` "
+                   f"refuses it without --force", err=True)
+    elif est.bytes > WARN_BYTES or est.seconds > WARN_SECONDS:
+        typer.echo(f"ropesim: warning: {where}: a large run (about {human(est.bytes)}, {_duration(est.seconds)})",
+                   err=True)
 
 
 @app.command(cls=Command)
@@ -246,7 +357,9 @@ def sweep(
 ) -> None:
     """Run a scene for every combination of --set values, in parallel; rerun, it resumes.
 
-    Exits 3 if any run did not complete (each is recorded with its error in results.csv), 130 if interrupted.
+    Exits 3 if any run did not complete (each is recorded with its error in results.csv); 130, 143 or 129
+    if stopped by Ctrl-C, SIGTERM or SIGHUP: no new run starts, the running ones stop at their next chunk and
+    keep their frames, results.csv is written, and a rerun continues the unfinished runs from their checkpoints.
     """
     from ..sweep.core import run_sweep
     from ..sweep.plan import SweepError
@@ -260,7 +373,9 @@ def sweep(
         typer.echo(f"{result.csv_path}: {len(result.rows)} runs ({result.ran} run now, {result.skipped} kept)"
                    + "".join(f"\n{path}" for path in result.plots))
     if result.interrupted:
-        fail(f"sweep interrupted; rerun the same command to finish it ({result.csv_path})", EXIT_INTERRUPTED)
+        fail(f"sweep interrupted{'' if result.stopped_by == 'SIGINT' else f' by {result.stopped_by}'}; rerun the "
+             f"same command to finish it (unfinished runs continue from their checkpoints) ({result.csv_path})",
+             exit_code(name=result.stopped_by))
     if result.failed:
         fail(f"{len(result.failed)} of {len(result.rows)} runs did not complete; see the error column of "
              f"{result.csv_path}", EXIT_BLEW_UP)
@@ -278,9 +393,27 @@ ViewOpt = Annotated[Optional[str], typer.Option(
 
 
 def _check_fps(fps: float) -> float:
-    if not fps > 0:
-        fail(f"--fps {fps:g}: must be a positive number of frames per second")
+    if not 0 < fps <= MAX_FPS:
+        fail(f"--fps {fps:g}: must be a positive number of frames per second, at most {MAX_FPS}")
     return fps
+
+
+MAX_FPS, SIZE_RANGE, WIDTH_RANGE, COLUMNS_RANGE, COUNT_RANGE = 1000, (32, 8192), (100, 16384), (1, 64), (1, 1000)
+
+
+def _bounded(option: str, low: int, high: int, what: str):
+    """A callback that refuses an integer option outside [low, high] in one line (exit 2)."""
+    def check(value):
+        if value is not None and not low <= value <= high:
+            fail(f"{option} {value}: must be {what} from {low} to {high}")
+        return value
+    return check
+
+
+def _check_speed(speed: float) -> float:
+    if not (0 < speed < float("inf")):
+        fail(f"--speed {speed:g}: must be a positive number of simulated seconds per second of video")
+    return speed
 
 
 FpsOpt = Annotated[float, typer.Option(
@@ -328,8 +461,8 @@ def _picture(make):
         fail(str(exc))
     except OSError as exc:
         fail(f"{exc.filename or 'output'}: cannot write ({exc.strerror or exc})")
-    except KeyboardInterrupt:
-        fail("interrupted; no picture written", EXIT_INTERRUPTED)
+    except (KeyboardInterrupt, Stopped) as exc:
+        fail("interrupted; no picture written", exit_code(exc))
 
 
 def _animate(run_dir: Path, out: Optional[Path], quiet: bool, **options) -> None:
@@ -350,14 +483,17 @@ def animate(
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output file, .gif or .mp4 (default "
                                                 "RUN_DIR/animation.gif).", show_default=False)] = None,
     fps: FpsOpt = 25.0,
-    speed: Annotated[float, typer.Option("--speed", help="Simulated seconds per second of video.")] = 1.0,
+    speed: Annotated[float, typer.Option("--speed", callback=_check_speed,
+                                         help="Simulated seconds per second of video.")] = 1.0,
     start: Annotated[Optional[float], typer.Option("--start", help="First time shown, in seconds (default: 0).",
                                                    show_default=False)] = None,
     end: Annotated[Optional[float], typer.Option("--end", help="Last time shown, in seconds (default: the run's end).",
                                                  show_default=False)] = None,
     follow: FollowOpt = False,
     view: ViewOpt = None,
-    size: Annotated[int, typer.Option("--size", help="The picture's longer side, in pixels.")] = 640,
+    size: Annotated[int, typer.Option("--size", callback=_bounded("--size", *SIZE_RANGE, "a number of pixels"),
+                                      help=f"The picture's longer side, in pixels ({SIZE_RANGE[0]} to "
+                                           f"{SIZE_RANGE[1]}).")] = 640,
     quiet: QuietOpt = False,
 ) -> None:
     """Animate a run folder as a GIF or an MP4 (by --out's extension), with the scene's geometry drawn."""
@@ -372,15 +508,22 @@ def frames(
     times: Annotated[Optional[str], typer.Option("--times", help="Times to show in seconds, comma-separated, e.g. "
                                                  "0,0.5,1,2,3 (the nearest saved frames).",
                                                  show_default=False)] = None,
-    count: Annotated[Optional[int], typer.Option("--count", help="Or this many frames evenly spaced from start "
+    count: Annotated[Optional[int], typer.Option("--count", callback=_bounded("--count", *COUNT_RANGE,
+                                                                              "a number of frames"),
+                                                 help="Or this many frames evenly spaced from start "
                                                  "to end (default 6; a run with fewer saved frames shows them "
-                                                 "all).", show_default=False)] = None,
+                                                 "all; at most 1000).", show_default=False)] = None,
     overlay: Annotated[bool, typer.Option("--overlay", help="All frames on one view, fading from the first to "
                                                             "the last, instead of side by side.")] = False,
     follow: FollowOpt = False,
     view: ViewOpt = None,
-    columns: Annotated[Optional[int], typer.Option("--columns", help="Panels per row.", show_default=False)] = None,
-    width: Annotated[Optional[int], typer.Option("--width", help="Picture width in pixels.", show_default=False)] = None,
+    columns: Annotated[Optional[int], typer.Option("--columns", callback=_bounded("--columns", *COLUMNS_RANGE,
+                                                                                  "a number of panels"),
+                                                   help="Panels per row (1 to 64).", show_default=False)] = None,
+    width: Annotated[Optional[int], typer.Option("--width", callback=_bounded("--width", *WIDTH_RANGE,
+                                                                              "a number of pixels"),
+                                                 help="Picture width in pixels (100 to 16384).",
+                                                 show_default=False)] = None,
     quiet: QuietOpt = False,
 ) -> None:
     """One PNG of selected frames of a run, side by side or overlaid."""
@@ -460,6 +603,21 @@ MethodsOpt = Annotated[Optional[str], typer.Option(
     show_default=False)]
 
 
+METHOD_NAMES = ("symplectic_euler", "verlet", "yoshida4", "pefrl", "rk4", "sdirk2")
+LADDER_WARN_STEPS = 1e9
+
+
+def _warn_ladder(scene, steps: dict[str, float], command: str) -> None:
+    """Warn (one line) before a ladder of a billion steps or more, with its estimated run time."""
+    from ..run import NS_PER_NODE_STEP
+
+    total = sum(steps.values())
+    if total >= LADDER_WARN_STEPS:
+        seconds = 1e-9 * scene.rope.nodes * sum(n * NS_PER_NODE_STEP.get(m, 1000.0) for m, n in steps.items())
+        typer.echo(f"ropesim: warning: {command}: about {total:.2g} steps in all, about {_duration(seconds)} of "
+                   f"computing; Ctrl-C stops it", err=True)
+
+
 def _methods(text: str | None) -> list[str] | None:
     from ..integrate.methods import METHODS
 
@@ -508,7 +666,16 @@ def accuracy(
     scene, _ = _load(scene_file, sets)
     names, ladder = _methods(methods), _numbers(dts, "--dts")
     folder = out if out is not None else Path("runs") / f"accuracy-{scene.name}"
-    report = accuracy_report(scene, names, ladder, repeats)
+    base = scene.integrator.dt
+    rungs = ladder or [base * f for f in (4, 2, 1, 0.5, 0.25, 0.125)]
+    t_end = scene.integrator.t_end
+    steps = {m: sum(t_end / dt for dt in rungs) * repeats for m in (names or METHOD_NAMES)}
+    steps["pefrl"] = steps.get("pefrl", 0) + 1.5 * t_end / (min(rungs) / 16)     # the reference
+    _warn_ladder(scene, steps, "accuracy")
+    try:
+        report = accuracy_report(scene, names, ladder, repeats)
+    except (KeyboardInterrupt, Stopped) as exc:
+        fail("accuracy interrupted; nothing written", exit_code(exc))
     try:
         folder.mkdir(parents=True, exist_ok=True)
         write_csv(report, folder / "accuracy.csv")
@@ -546,7 +713,12 @@ def stability(
     names, ladder = _methods(methods), _numbers(fractions, "--fractions")
     ks = _numbers(stiffness, "--k")
     folder = out if out is not None else Path("runs") / f"stability-{scene.name}"
-    result = stability_sweep(scene, names, ladder, ks, steps)
+    probes = (len(ladder or range(20)) + 20) * len(ks or [0])       # the ladder and about 20 bisection probes
+    _warn_ladder(scene, {m: probes * steps for m in (names or METHOD_NAMES)}, "stability")
+    try:
+        result = stability_sweep(scene, names, ladder, ks, steps)
+    except (KeyboardInterrupt, Stopped) as exc:
+        fail("stability interrupted; nothing written", exit_code(exc))
     try:
         write_sweep(result, folder)
         plot_sweep(result, folder / "stability.png")
@@ -555,13 +727,26 @@ def stability(
     print_stability(result, folder)
 
 
+def _raise_stopped(signum, _frame) -> None:
+    import signal
+
+    raise Stopped(signal.Signals(signum).name)
+
+
 def main() -> None:
-    """Entry point. A Ctrl-C outside a run's own clean stop (say, while Python imports) is one line too."""
+    """Entry point. SIGTERM and SIGHUP end a command as Ctrl-C does (a run stops cleanly at its next chunk and
+    keeps its frames); outside a run's own clean stop (say, while Python imports) they are one line too."""
+    import signal
+
+    for name in ("SIGTERM", "SIGHUP"):
+        if hasattr(signal, name):
+            signal.signal(getattr(signal, name), _raise_stopped)
     try:
         app()
-    except KeyboardInterrupt:
-        typer.echo("ropesim: interrupted", err=True)
-        sys.exit(EXIT_INTERRUPTED)
+    except (KeyboardInterrupt, Stopped) as exc:
+        name = exc.name if isinstance(exc, Stopped) else "SIGINT"
+        typer.echo(f"ropesim: {'interrupted' if name == 'SIGINT' else f'stopped by {name}'}", err=True)
+        sys.exit(exit_code(exc))
 
 
 if __name__ == "__main__":  # pragma: no cover

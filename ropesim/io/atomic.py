@@ -1,7 +1,13 @@
-"""Atomic output files: written beside their final name, moved into place only when complete."""
+"""Atomic, durable output files: written beside their final name, flushed, moved into place only when complete.
+
+The sequence is SQLite's and every careful database's: write a temporary file in the same folder, ``fsync`` it,
+``rename`` it over the final name (atomic on POSIX), then ``fsync`` the folder so that the rename itself
+survives a power cut. A reader sees the old file or the new one, never half of either.
+"""
 
 from __future__ import annotations
 
+import errno
 import os
 import tempfile
 from contextlib import contextmanager
@@ -18,12 +24,28 @@ def _umask() -> int:
 FILE_MODE = 0o666 & ~_umask()  # what open() would give a new file (mkstemp's own 0600 would hide results)
 
 
+def fsync_path(path: str | Path) -> None:
+    """``fsync`` a file or a folder by name (a folder's entries: renames and new files in it)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0) if Path(path).is_dir() else os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError as exc:  # some file systems cannot fsync a folder; that is their durability, not an error
+        if exc.errno not in (errno.EINVAL, errno.ENOTSUP, errno.EBADF):
+            raise
+    finally:
+        os.close(fd)
+
+
 @contextmanager
-def atomic_output(path: str | Path) -> Iterator[Path]:
+def atomic_output(path: str | Path, durable: bool = True) -> Iterator[Path]:
     """Yield a temporary path beside ``path`` (same extension); move it into place only if the block succeeds.
 
     Any error or interrupt inside the block removes the temporary file, so ``path`` is either its old self
-    or the complete new file, with the permissions a newly created file gets.
+    or the complete new file, with the permissions a newly created file gets. With ``durable`` the file is
+    flushed to disk before the rename and the folder after it.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -32,7 +54,11 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     try:
         yield Path(tmp)
         os.chmod(tmp, FILE_MODE)
+        if durable:
+            fsync_path(tmp)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+    if durable:
+        fsync_path(path.parent)

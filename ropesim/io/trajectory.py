@@ -4,15 +4,15 @@
 t = 0. It is an ordinary uncompressed ``.npz`` (``numpy.load`` reads it), written so that each array can also be
 memory-mapped: :meth:`Trajectory.open` reads frames lazily, so a trajectory of any size can be analysed.
 
-Frames stream to memory-mapped ``.npy`` files in a hidden folder while the run goes on; the ``.npz`` is then
-assembled beside its final name and moved into place, so a reader never sees half a file.
+While the run goes on, frames stream to ``checkpoint/`` in durable checkpoints, and ``manifest.json`` says
+what the folder holds (:mod:`ropesim.io.runfolder`); a finished run's ``.npz`` files are assembled beside their
+final names and moved into place, so a reader never sees half a file. :meth:`Trajectory.open` reads either,
+checking every frame's CRC-32 first.
 """
 
 from __future__ import annotations
 
 import json
-import shutil
-import tempfile
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,17 +21,16 @@ import numpy as np
 
 from .atomic import atomic_output
 
-TRAJECTORY, SCENE, SUMMARY = "trajectory.npz", "scene.toml", "summary.json"
+from .runfolder import (CHECKPOINT, FINISHED, INCOMPLETE, INTERRUPTED, LEDGER, MANIFEST, SCENE, SUMMARY,  # noqa: F401
+                        TRAJECTORY, RunFolderError, holder, memmap_npz, open_stream_array, read_manifest,
+                        write_npz_atomic)
+
 ARRAYS = ("t", "x", "v")
 DERIVED = ("tension", "strain", "support")   # per frame, derived from t, x and v as they are stored
 
 
-class RunFolderError(ValueError):
-    """A run folder that cannot be read; ``str()`` is one line for the user."""
-
-
 def write_text_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` via a temporary file in the same folder and an atomic rename."""
+    """Write ``text`` to ``path`` via a temporary file in the same folder, fsync and an atomic rename."""
     with atomic_output(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
 
@@ -40,133 +39,65 @@ def write_json_atomic(path: Path, data: dict) -> None:
     write_text_atomic(path, json.dumps(data, indent=2, sort_keys=False) + "\n")
 
 
-WRITE_BLOCK_BYTES = 16 * 2 ** 20  # an array is written this many bytes at a time, never copied whole
-
-
-def _write_npy(fh, arr) -> None:
-    """Write ``arr`` in .npy format to ``fh``, a block of leading rows at a time (a memory map is read lazily)."""
-    arr = np.asarray(arr)
-    if not arr.flags.c_contiguous:
-        arr = np.ascontiguousarray(arr)
-    np.lib.format.write_array_header_1_0(fh, np.lib.format.header_data_from_array_1_0(arr))
-    if arr.ndim == 0 or arr.size == 0:
-        fh.write(arr.tobytes())
-        return
-    rows = max(1, WRITE_BLOCK_BYTES // max(1, arr[0].nbytes))
-    for start in range(0, len(arr), rows):
-        fh.write(np.ascontiguousarray(arr[start:start + rows]).data)
-
-
-def write_npz_atomic(path: Path, arrays: dict[str, np.ndarray]) -> None:
-    """Write an uncompressed, memory-mappable ``.npz`` atomically, streaming each array in chunks."""
-    with atomic_output(path) as tmp:
-        with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_STORED, allowZip64=True) as zf:
-            for name, arr in arrays.items():
-                with zf.open(f"{name}.npy", "w", force_zip64=True) as fh:
-                    _write_npy(fh, arr)
-
-
-def _memmap_npz(path: Path) -> dict[str, np.ndarray]:
-    """Memory-map every array of an uncompressed ``.npz`` (as ``write_npz_atomic`` makes them)."""
-    out = {}
-    with zipfile.ZipFile(path) as zf, open(path, "rb") as fh:
-        for info in zf.infolist():
-            name = info.filename.removesuffix(".npy")
-            if info.compress_type != zipfile.ZIP_STORED:
-                out[name] = np.load(zf.open(info.filename), allow_pickle=False)
-                continue
-            fh.seek(info.header_offset)
-            local = fh.read(30)
-            if local[:4] != b"PK\x03\x04":
-                raise RunFolderError(f"{path}: corrupt zip entry {info.filename}")
-            name_len = int.from_bytes(local[26:28], "little")
-            extra_len = int.from_bytes(local[28:30], "little")
-            fh.seek(info.header_offset + 30 + name_len + extra_len)
-            version = np.lib.format.read_magic(fh)
-            if version == (1, 0):
-                shape, fortran, dtype = np.lib.format.read_array_header_1_0(fh)
-            else:
-                shape, fortran, dtype = np.lib.format.read_array_header_2_0(fh)
-            offset = fh.tell()
-            if np.prod(shape) == 0:
-                out[name] = np.zeros(shape, dtype=dtype)
-            else:
-                out[name] = np.memmap(path, dtype=dtype, mode="r", offset=offset, shape=shape,
-                                      order="F" if fortran else "C")
-    return out
-
-
 class FrameStore:
-    """Where a run's saved frames go: memory for :func:`ropesim.simulate`, disk for a run folder.
+    """Where a run's saved frames go in memory (:func:`ropesim.simulate` without a folder; a run folder streams
+    them through :class:`ropesim.io.runfolder.RunWriter` instead).
 
-    With ``derive`` (a function of the frames' t (k,), x and v (k, N, D) returning named (k, ...) arrays, and
-    ``shapes`` their per-frame shapes) each appended chunk also stores what it derives: the segments' tension
-    and strain, the supports' forces (:mod:`ropesim.model.tension`).
+    Named per-frame arrays: ``t``, ``x``, ``v``, ``ledger`` (the energy ledger's flows), and with ``derive`` (a
+    function of the frames' t (k,), x and v (k, N, D) returning named (k, ...) arrays, ``shapes`` their per-frame
+    shapes) what it derives: the segments' tension and strain, the supports' forces
+    (:mod:`ropesim.model.tension`).
     """
 
     def __init__(self, n_frames: int, nodes: int, dim: int, folder: Path | None = None, derive=None,
-                 shapes: dict[str, tuple] | None = None):
-        self.count = 0
-        self.folder = folder
-        self.derive = derive
-        self.names = ARRAYS + tuple(shapes or {})
-        shape = {"t": (n_frames,), "x": (n_frames, nodes, dim), "v": (n_frames, nodes, dim),
-                 **{name: (n_frames, *s) for name, s in (shapes or {}).items()}}
-        if folder is None:
-            self._tmp = None
-            for name in self.names:
-                setattr(self, name, np.zeros(shape[name]))
-        else:
-            folder.mkdir(parents=True, exist_ok=True)
-            self._tmp = Path(tempfile.mkdtemp(prefix=".frames-", dir=folder))
-            open_mm = np.lib.format.open_memmap
-            for name in self.names:
-                setattr(self, name, open_mm(self._tmp / f"{name}.npy", mode="w+", dtype=np.float64,
-                                            shape=shape[name]))
+                 shapes: dict[str, tuple] | None = None, ledger_columns: int | None = None):
+        from ..integrate.health import LEDGER_COLUMNS
 
-    def append(self, t: np.ndarray, x_dn: np.ndarray, v_dn: np.ndarray) -> None:
-        """Append frames given in kernel layout (F, D, N)."""
+        if folder is not None:
+            raise TypeError("FrameStore keeps frames in memory; a run folder is written by ropesim.simulate")
+        self.count = 0
+        self.derive = derive
+        self.specs = {"t": (), "x": (nodes, dim), "v": (nodes, dim), **(shapes or {}),
+                      "ledger": (ledger_columns or len(LEDGER_COLUMNS),)}
+        self.names = tuple(self.specs)
+        self._arrays = {name: np.zeros((n_frames, *s)) for name, s in self.specs.items()}
+
+    def __getattr__(self, name):
+        arrays = self.__dict__.get("_arrays", {})
+        if name in arrays:
+            return arrays[name]
+        raise AttributeError(name)
+
+    def rows(self, t: np.ndarray, x_dn: np.ndarray, v_dn: np.ndarray, ledger: np.ndarray | None) -> dict:
+        """Frames given in kernel layout (F, D, N), as the named per-frame arrays to store."""
+        x, v = np.swapaxes(x_dn, 1, 2), np.swapaxes(v_dn, 1, 2)
+        out = {"t": np.asarray(t), "x": x, "v": v}
+        if self.derive is not None:
+            out.update(self.derive(out["t"], x, v))
+        out["ledger"] = np.zeros((len(t), self.specs["ledger"][0])) if ledger is None else ledger
+        return out
+
+    def append(self, t: np.ndarray, x_dn: np.ndarray, v_dn: np.ndarray, ledger: np.ndarray | None = None) -> None:
+        """Append frames given in kernel layout (F, D, N) (and their ledger rows)."""
         k = len(t)
         if k == 0:
             return
         end = self.count + k
-        self.t[self.count:end] = t
-        self.x[self.count:end] = np.swapaxes(x_dn, 1, 2)
-        self.v[self.count:end] = np.swapaxes(v_dn, 1, 2)
-        if self.derive is not None:
-            for name, values in self.derive(self.t[self.count:end], self.x[self.count:end],
-                                            self.v[self.count:end]).items():
-                getattr(self, name)[self.count:end] = values
+        for name, values in self.rows(t, x_dn, v_dn, ledger).items():
+            self._arrays[name][self.count:end] = values
         self.count = end
 
     def arrays(self) -> dict[str, np.ndarray]:
-        return {name: getattr(self, name)[:self.count] for name in self.names}
-
-    def finish(self) -> None:
-        """Write ``trajectory.npz`` (frames so far) atomically and drop the streaming files."""
-        if self.folder is None:
-            return
-        try:
-            write_npz_atomic(self.folder / TRAJECTORY, self.arrays())
-        finally:
-            self.discard()
-
-    def discard(self) -> None:
-        if self._tmp is not None:
-            for name in self.names:
-                arr = getattr(self, name)
-                if isinstance(arr, np.memmap):
-                    arr._mmap.close()
-            shutil.rmtree(self._tmp, ignore_errors=True)
-            self._tmp = None
+        return {name: a[:self.count] for name, a in self._arrays.items()}
 
 
 @dataclass
 class Trajectory:
     """Saved frames of one run: ``t`` (F,) [s], ``x`` and ``v`` (F, N, D) [m, m/s], each segment's ``tension``
     [N] and ``strain`` (F, S), the force each support exerts on its held node, ``support`` (F, H, D) [N] (None
-    without held nodes), with its scene and summary (the derived arrays are None for a run folder written
-    before ropesim stored them).
+    without held nodes), the energy ledger's flows ``ledger`` (F, C) [J] (columns
+    :data:`ropesim.integrate.health.LEDGER_COLUMNS`), with its scene and summary (the derived arrays and
+    ``ledger`` are None for a run folder written before ropesim stored them).
 
     From :func:`ropesim.simulate` the arrays are in memory; from :meth:`open` they are memory-mapped.
     """
@@ -180,6 +111,7 @@ class Trajectory:
     tension: np.ndarray | None = None
     strain: np.ndarray | None = None
     support: np.ndarray | None = None
+    ledger: np.ndarray | None = None   # (F, C) the energy ledger's cumulative flows [J], columns LEDGER_COLUMNS
 
     @property
     def frames(self) -> int:
@@ -190,24 +122,31 @@ class Trajectory:
         return self.x.shape[1]
 
     @classmethod
-    def open(cls, folder: str | Path) -> "Trajectory":
-        """Read a run folder lazily; raises :class:`RunFolderError` with one clear line if it is unusable."""
+    def open(cls, folder: str | Path, verify: bool = True) -> "Trajectory":
+        """Read a run folder lazily; raises :class:`RunFolderError` with one clear line if it is unusable.
+
+        A finished run is read from ``trajectory.npz``; an unfinished one (interrupted, killed, still running)
+        from its last checkpoint. With ``verify`` (the default) every array's CRC-32 is checked first.
+        """
         from ..scene.loader import SceneError, load_scene
 
         folder = Path(folder)
         if not folder.is_dir():
             raise RunFolderError(f"{folder}: no such run folder (make one with `ropesim run SCENE.toml`)")
-        for name in (TRAJECTORY, SCENE):
-            if not (folder / name).is_file():
-                raise RunFolderError(f"{folder}: not a run folder: {name} is missing")
-        try:
-            scene = load_scene(folder / SCENE)
-        except SceneError as exc:
-            raise RunFolderError(f"{folder}: its scene.toml is not valid: {exc}") from None
-        try:
-            arrays = _memmap_npz(folder / TRAJECTORY)
-        except (zipfile.BadZipFile, ValueError, OSError, EOFError) as exc:
-            raise RunFolderError(f"{folder / TRAJECTORY}: corrupt or unreadable ({exc})") from None
+        for attempt in range(3):
+            manifest = read_manifest(folder)
+            if not (folder / SCENE).is_file():
+                raise RunFolderError(f"{folder}: not a run folder: {SCENE} is missing")
+            try:
+                scene = load_scene(folder / SCENE)
+            except SceneError as exc:
+                raise RunFolderError(f"{folder}: its scene.toml is not valid: {exc}") from None
+            try:
+                arrays, ledger, summary = _read_frames(folder, manifest, verify)
+                break
+            except _Moved:      # the run committed (or finished) while we read: read the new manifest
+                if attempt == 2:
+                    raise RunFolderError(f"{folder}: changes too fast to read (a run is finishing there)") from None
         missing = [a for a in ARRAYS if a not in arrays]
         if missing:
             raise RunFolderError(f"{folder / TRAJECTORY}: missing arrays {', '.join(missing)}")
@@ -221,13 +160,9 @@ class Trajectory:
             if values is not None and (values.ndim < 2 or values.shape[0] != len(t)):
                 raise RunFolderError(f"{folder / TRAJECTORY}: {name} has shape {values.shape}, not one row per "
                                      f"frame ({len(t)})")
-        summary = {}
-        if (folder / SUMMARY).is_file():
-            try:
-                summary = json.loads((folder / SUMMARY).read_text(encoding="utf-8"))
-            except (ValueError, OSError):
-                summary = {}
-        return cls(t=t, x=x, v=v, scene=scene, summary=summary, folder=folder, **derived)
+        if ledger is not None and len(ledger) != len(t):
+            ledger = None
+        return cls(t=t, x=x, v=v, scene=scene, summary=summary, folder=folder, ledger=ledger, **derived)
 
     # Other tools and notebooks (ropesim.io.export, ropesim.render.notebook).
     def export(self, to: str, out: str | Path | None = None):
@@ -248,3 +183,60 @@ class Trajectory:
         return (f"Trajectory(scene={self.scene.name!r}, {self.summary.get('status', 'completed')}, "
                 f"{self.frames} frames, t = {float(self.t[0]):.6g} .. {float(self.t[-1]):.6g} s, "
                 f"{self.nodes} nodes, {self.x.shape[2]}-D, {'in memory' if self.folder is None else self.folder})")
+
+
+class _Moved(Exception):
+    """A checkpoint file vanished while reading: the run moved on; read its manifest again."""
+
+
+def _summary_file(folder: Path) -> dict:
+    try:
+        return json.loads((folder / SUMMARY).read_text(encoding="utf-8"))
+    except (ValueError, OSError):
+        return {}
+
+
+def _read_frames(folder: Path, manifest: dict | None, verify: bool):
+    """(named arrays, ledger (F, C) or None, summary) of a run folder, as its manifest says."""
+    if manifest is None or manifest["status"] in FINISHED:
+        if not (folder / TRAJECTORY).is_file():
+            raise RunFolderError(f"{folder}: not a run folder: {TRAJECTORY} is missing")
+        try:
+            arrays = memmap_npz(folder / TRAJECTORY, verify=verify)
+        except RunFolderError:
+            raise
+        except (zipfile.BadZipFile, ValueError, OSError, EOFError) as exc:
+            raise RunFolderError(f"{folder / TRAJECTORY}: corrupt or unreadable ({exc})") from None
+        return arrays, _read_ledger(folder), _summary_file(folder)
+    cp = manifest.get("checkpoint")
+    running = holder(folder)
+    if not cp or not cp.get("frames"):
+        what = f"is still starting (pid {running})" if running else "was stopped before its first checkpoint"
+        raise RunFolderError(f"{folder}: {what}: no frames yet")
+    arrays = {}
+    for name, spec in manifest["arrays"].items():
+        path = folder / CHECKPOINT / f"{name}.npy"
+        if not path.is_file():
+            raise _Moved()
+        arrays[name] = open_stream_array(path, tuple(spec["per_frame"]), np.dtype(spec["dtype"]), cp["frames"],
+                                         cp["crc32"].get(name), verify=verify)
+    ledger = arrays.pop("ledger", None)
+    summary = _summary_file(folder) if manifest["status"] == INTERRUPTED else {}
+    if summary.get("status") != manifest["status"]:
+        state = (f"still running ({running})" if running else
+                 "never finished (killed, or stopped by a full disk)")
+        summary = {"scene": manifest.get("scene", folder.name), "status": INCOMPLETE,
+                   "message": f"{state}; the last checkpoint is at t = {cp['t']:.6g} s ({cp['frames']} frames); "
+                              f"`ropesim run --resume {folder}` continues it",
+                   "t_end": cp["t"], "frames": cp["frames"], "steps": cp["step"]}
+    return arrays, ledger, summary
+
+
+def _read_ledger(folder: Path) -> np.ndarray | None:
+    from ..analysis.ledger import read_flows
+
+    try:
+        flows = read_flows(folder)
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile, EOFError) as exc:
+        raise RunFolderError(f"{folder / LEDGER}: corrupt or unreadable ({exc})") from None
+    return None if flows is None else flows[0]

@@ -13,7 +13,10 @@ its own (or on a Dask cluster, :mod:`ropesim.sweep.dask`), into ``DIR/<key=value
 ``shooter.mean_loop_inclination_deg``, ...), one row per combination in the order of the product.
 
 Rerun, a sweep resumes: a run folder whose summary says completed and whose scene.toml equals the resolved
-scene is kept; any other (crashed, interrupted, blown up, or made from other parameters) runs again.
+scene is kept; an unfinished run of the same scene (interrupted, killed) continues from its last checkpoint,
+bit for bit; any other (blown up, or made from other parameters) runs again. Ctrl-C or SIGTERM stop a sweep
+cleanly: no new run starts, the running ones stop at their next chunk keeping their frames, results.csv is
+written for what finished, and every worker process has exited.
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ from pathlib import Path
 from typing import Iterable
 
 from ..io.trajectory import SUMMARY, write_text_atomic
+from ..stop import Stopped
 from .plan import Point, SweepError, _numeric_axis, plan, toml_value
 from .points import Outcome, is_finished, run_local
 
@@ -49,6 +53,7 @@ class SweepResult:
     ran: int = 0
     skipped: int = 0
     interrupted: bool = False
+    stopped_by: str = ""
 
     @property
     def failed(self) -> list[dict]:
@@ -127,9 +132,8 @@ def run_sweep(scene_file: str | Path, sets: list[str], out: str | Path | None = 
     done = {p.name for p in points if is_finished(folders[p.name], p.scene_toml)}
     todo = [(p, folders[p.name]) for p in points if p.name not in done]
     try:
-        for _, folder in todo:
+        for _, folder in todo:   # (a run killed midway never looks finished: its manifest says incomplete)
             folder.mkdir(parents=True, exist_ok=True)
-            (folder / SUMMARY).unlink(missing_ok=True)  # a run killed midway must never look finished
     except OSError as exc:
         raise SweepError(f"--out {root}: cannot write the run folders ({exc.strerror or exc})") from None
 
@@ -151,8 +155,9 @@ def run_sweep(scene_file: str | Path, sets: list[str], out: str | Path | None = 
                     for outcome in results:
                         outcomes[outcome[0].name] = outcome
                         progress.finished(*outcome)
-        except KeyboardInterrupt:
+        except (KeyboardInterrupt, Stopped) as exc:
             result.interrupted = True
+            result.stopped_by = exc.name if isinstance(exc, Stopped) else "SIGINT"
         finally:
             result.rows = [_final_row(p, folders[p.name], outcomes.get(p.name)) for p in points]
             root.mkdir(parents=True, exist_ok=True)

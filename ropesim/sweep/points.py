@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import multiprocessing
+import os
 import signal
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
@@ -28,12 +29,40 @@ def is_finished(folder: Path, scene_toml: str) -> bool:
 # -------------------------------------------------------------------------------------- running
 
 
-def run_point(scene_toml: str, folder: str) -> dict:
-    """Run one resolved scene into ``folder``, exactly as ``ropesim run`` does; returns its summary."""
-    from ..run import simulate
+NOT_STARTED = "not run (the sweep was stopped first)"
+_STOP = None          # in a worker: the sweep's stop event (set by the parent on Ctrl-C or SIGTERM)
+_PARENT = None        # in a worker: the parent's pid (a worker whose parent died stops too)
 
+
+def _stopping() -> bool:
+    return (_STOP is not None and _STOP.is_set()) or (_PARENT is not None and os.getppid() != _PARENT)
+
+
+def run_point(scene_toml: str, folder: str) -> dict:
+    """Run one resolved scene into ``folder``, exactly as ``ropesim run`` does; returns its summary.
+
+    A folder holding an unfinished run of this very scene (interrupted, killed) continues from its last
+    checkpoint, bit for bit as if it had never stopped; anything else there is replaced.
+    """
+    from ..run import resume, simulate
+
+    if _stopping():
+        return {"status": "not_started"}
+    if _resumable(Path(folder), scene_toml):
+        return resume(folder, stop=_stopping).summary
     scene = scene_from_toml(scene_toml, source=str(Path(folder) / SCENE))
-    return simulate(scene, folder).summary
+    return simulate(scene, folder, stop=_stopping).summary
+
+
+def _resumable(folder: Path, scene_toml: str) -> bool:
+    from ..io.runfolder import FINISHED, read_manifest, scene_hash
+
+    try:
+        manifest = read_manifest(folder)
+    except ValueError:
+        return False
+    return (manifest is not None and manifest["status"] not in FINISHED and bool(manifest.get("checkpoint"))
+            and manifest.get("scene_sha256") == scene_hash(scene_toml))
 
 
 def run_point_safely(scene_toml: str, folder: str) -> tuple[dict | None, str]:
@@ -42,18 +71,24 @@ def run_point_safely(scene_toml: str, folder: str) -> tuple[dict | None, str]:
     The error travels as text because not every exception survives pickling back from a worker process.
     """
     try:
-        return run_point(scene_toml, folder), ""
+        summary = run_point(scene_toml, folder)
     except Exception as exc:  # a run's own failure is recorded in the table; the sweep goes on
         return None, describe(exc)
+    if summary.get("status") == "not_started":
+        return None, NOT_STARTED
+    return summary, ""
 
 
 def describe(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {' '.join(str(exc).split())}"
 
 
-def _ignore_sigint() -> None:
-    """Worker start-up: Ctrl-C reaches a worker only while it integrates, where the run stops cleanly."""
+def _worker_start(stop, parent: int) -> None:
+    """Worker start-up: Ctrl-C reaches a worker only while it integrates, where the run stops cleanly; the
+    sweep's stop event and the parent's pid tell it to start nothing new and stop the run in progress."""
+    global _STOP, _PARENT
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _STOP, _PARENT = stop, parent
 
 
 Outcome = tuple[Point, dict | None, str]  # the point, its summary (None if it raised), the error text
@@ -62,16 +97,22 @@ Outcome = tuple[Point, dict | None, str]  # the point, its summary (None if it r
 def run_local(todo: list[tuple[Point, Path]], jobs: int) -> Iterator[Outcome]:
     """Run points in a pool of ``jobs`` fresh processes; yields each outcome as it finishes.
 
-    Closing the generator early (Ctrl-C) cancels the runs not yet started and waits for those in progress,
-    which saw the same Ctrl-C and stop at their next chunk, keeping what they computed.
+    Closing the generator early (Ctrl-C, SIGTERM) sets the workers' stop event: no run starts after it, and
+    those in progress stop at their next chunk, keeping their frames for a rerun to resume; then every
+    worker has exited.
     """
     context = multiprocessing.get_context("spawn")
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=context, initializer=_ignore_sigint)
+    stop = context.Event()
+    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=context, initializer=_worker_start,
+                               initargs=(stop, os.getpid()))
     futures = {pool.submit(run_point_safely, p.scene_toml, str(folder)): p for p, folder in todo}
     try:
         for future in as_completed(futures):
-            yield _outcome(futures[future], future.result)
+            outcome = _outcome(futures[future], future.result)
+            if outcome[2] != NOT_STARTED:
+                yield outcome
     finally:
+        stop.set()
         pool.shutdown(wait=True, cancel_futures=True)
 
 
