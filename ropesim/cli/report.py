@@ -131,7 +131,10 @@ def print_check(scene: Scene, source: Path) -> None:
         table.add_row("physical form", f"{rope.length:g} m in {rope.segments} segments, {rope.mass_per_length:g} "
                                        f"kg/m, EA = {rope.EA:g} N"
                                        + (f", d = {rope.diameter:g} m" if rope.diameter else ""))
-    table.add_row("initial", f"{scene.initial.shape}, velocity {list(scene.initial.velocity)} m/s")
+    init = scene.initial
+    moving = ("a velocity per node" if getattr(init, "velocities", None) is not None
+              else f"velocity {list(init.velocity)} m/s")
+    table.add_row("initial", f"{init.shape}, {moving}")
     terms = ["springs"]
     if scene.bending:
         terms.append(f"bending (k2 = {scene.bending.stiffness:g} N/m)")

@@ -75,7 +75,10 @@ def build(scene: S.Scene) -> Model:
     n, dim = scene.rope.nodes, scene.dimension
     x0 = initial_positions(scene)
     v0 = np.empty((dim, n))
-    v0[:] = np.asarray(scene.initial.velocity, dtype=float)[:, None]
+    if getattr(scene.initial, "velocities", None) is not None:
+        v0[:] = np.asarray(scene.initial.velocities, dtype=float).T
+    else:
+        v0[:] = np.asarray(scene.initial.velocity, dtype=float)[:, None]
 
     mass = np.full(n, scene.rope.mass)
     if scene.rope.physical and not scene.rope.closed:

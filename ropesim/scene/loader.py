@@ -203,7 +203,11 @@ class _Ctx:
         start = self.build(init, S.INITIAL_SHAPES[shape], "initial", skip=("shape",),
                            what=f"a key of [initial] with shape = '{shape}'")
         zeros = (0.0,) * self.dim
-        if start.velocity is None:
+        if isinstance(start, S.PointsStart) and start.velocities is not None:
+            if start.velocity is not None:
+                raise SceneError(self.source, "initial.velocities", "give one velocity for every node "
+                                 "(velocity) or one per node (velocities), not both")
+        elif hasattr(start, "velocity") and start.velocity is None:
             start = replace(start, velocity=zeros)
         if isinstance(start, S.HangingStart) and start.top is None:
             start = replace(start, top=zeros)
@@ -220,7 +224,7 @@ def _check_scene(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
     _check_nodes(scene, fail)
     _check_fluid(scene, fail)
     scene = _resolve_driven(scene, base_dir, fail)
-    scene = _resolve_initial(scene, fail)
+    scene = _resolve_initial(_read_start(scene, base_dir, fail), fail)
     scene = _resolve_omegas(scene, fail)
     _check_flow_covers_the_rope(scene, fail)
     _check_seabed(scene, fail)
@@ -524,6 +528,45 @@ def _check_nodes(scene: S.Scene, fail) -> None:
             fail(f"overrides.{j}", "sets neither mass nor drag; give at least one")
 
 
+def _read_start(scene: S.Scene, base_dir: Path, fail) -> S.Scene:
+    """An ``initial.shape = "from_run"`` start read from its run folder into a ``points`` start."""
+    init = scene.initial
+    if not isinstance(init, S.FromRunStart):
+        return scene
+    import numpy as np
+
+    from ..io.runfolder import RunFolderError
+    from ..io.trajectory import Trajectory
+
+    folder = Path(init.run)
+    folder = folder if folder.is_absolute() else base_dir / folder
+    try:
+        traj = Trajectory.open(folder)
+    except RunFolderError as exc:
+        fail("initial.run", f"cannot start from it: {exc}")
+    n, dim = scene.rope.nodes, scene.dimension
+    if traj.x.shape[1:] != (n, dim):
+        fail("initial.run", f"{folder} holds {traj.x.shape[1]} nodes in {traj.x.shape[2]}-D, but this rope has "
+                            f"{n} nodes in {dim}-D")
+    t = np.asarray(traj.t)
+    if init.time is None:
+        k = len(t) - 1
+    else:
+        k = int(np.argmin(np.abs(t - init.time)))
+        if abs(t[k] - init.time) > 1e-9 * max(1.0, abs(init.time)):
+            step = f", every {t[1] - t[0]:.6g} s" if len(t) > 1 else ""
+            fail("initial.time", f"{folder} saved no frame at t = {init.time:g} s; it saved frames from "
+                                 f"{t[0]:g} to {t[-1]:g} s{step} (nearest: {t[k]:.6g} s)")
+    x, v = np.asarray(traj.x[k], dtype=float), np.asarray(traj.v[k], dtype=float)
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(v))):
+        fail("initial.time", f"{folder}'s frame at t = {t[k]:g} s is not finite (the run blew up); choose an "
+                             f"earlier one")
+    velocities = (None if init.at_rest else tuple(tuple(float(c) for c in row) for row in v))
+    start = S.PointsStart(points=tuple(tuple(float(c) for c in row) for row in x),
+                          velocity=(0.0,) * dim if init.at_rest else None, velocities=velocities)
+    return replace(scene, initial=start)
+
+
 def _resolve_initial(scene: S.Scene, fail) -> S.Scene:
     """The initial shape fits the rope; the square loop's default centre is the thrower's."""
     rope, n, init = scene.rope, scene.rope.nodes, scene.initial
@@ -540,6 +583,9 @@ def _resolve_initial(scene: S.Scene, fail) -> S.Scene:
     if isinstance(init, S.PointsStart):
         if len(init.points) != n:
             fail("initial.points", f"has {len(init.points)} points but rope.nodes is {n}; give one per node")
+        if init.velocities is not None and len(init.velocities) != n:
+            fail("initial.velocities", f"has {len(init.velocities)} velocities but rope.nodes is {n}; give one "
+                                       f"per node")
         pts = init.points
         pairs = [(i, i + 1) for i in range(n - 1)] + ([(n - 1, 0)] if rope.closed else [])
         for i, j in pairs:

@@ -294,11 +294,27 @@ class SquareLoopStart:
 
 @dataclass(frozen=True)
 class PointsStart:
-    """An explicit list of node positions."""
+    """An explicit list of node positions, and one velocity for every node or one per node."""
 
     points: tuple = spec("points", "one position per node", "m")
     velocity: tuple = spec("vector", "initial velocity of every node", "m/s", default=None, required=False)
+    velocities: tuple | None = spec("points", "initial velocity of each node (instead of velocity)", "m/s",
+                                    default=None, required=False)
     shape: str = "points"
+
+
+@dataclass(frozen=True)
+class FromRunStart:
+    """A saved frame of another run: relax a rope in one run, then perturb it in the next. The loader reads
+    the frame (its positions and, unless ``at_rest``, its velocities) from the run folder into a ``points``
+    start, so the resolved scene carries the frame itself and runs without the folder. The rope must have the
+    run's number of nodes and dimension."""
+
+    run: str = spec("str", "run folder to start from (relative to the scene file's folder)")
+    time: float | None = spec("float", "time of the saved frame to start from", "s", default=None, required=False,
+                              low=0)
+    at_rest: bool = spec("bool", "start every node at rest instead of with the frame's velocities", default=False)
+    shape: str = "from_run"
 
 
 @dataclass(frozen=True)
@@ -321,6 +337,7 @@ INITIAL_SHAPES = {
     "square_loop": SquareLoopStart,
     "points": PointsStart,
     "equilibrium": EquilibriumStart,
+    "from_run": FromRunStart,
 }
 InitialShape = HangingStart | LineStart | SquareLoopStart | PointsStart | EquilibriumStart
 
