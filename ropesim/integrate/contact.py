@@ -17,13 +17,13 @@ A one-sided circle's smooth release depends on v_r nonlinearly: it is frozen at 
 
 import math
 
-from numba import njit
 
 from ..model.forces.thrower import box_of, smooth_step, weight_at
 from ..model.terms import GUIDES, THROWER
+from ..model.jit import kernel
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def _phi(lam, tau):
     """(1 - e^(-lam tau)) / lam, and tau at lam = 0."""
     z = lam * tau
@@ -32,7 +32,7 @@ def _phi(lam, tau):
     return -math.expm1(-z) / lam
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def exact_contact_kicks(x, v, acc, out, nodes, tau, gamma, free, forces):
     """For every free node the box or a circle touches, its velocity after an exact kick of length ``tau``
     into ``out[:, i]``, its index into ``nodes``; returns how many. ``acc`` is a(x, v) without drag and

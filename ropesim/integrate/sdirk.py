@@ -28,7 +28,6 @@ from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from ..model.jacobian import Jacobian, band_width
 from ..model.forces.added_mass import added_mass_times
@@ -37,6 +36,7 @@ from ..model.terms import (ADDED_MASS, accelerations, added_mass, any_applied, a
 from ..model.banded import factor, solve, woodbury
 from .base import Integrator, Method
 from .health import BOX, DRAG, FLUID, HELD, INTERNAL, NEWTON_FAILED, OK, SEABED, due, end_step, held_power, place, power
+from ..model.jit import kernel
 
 GAMMA = 1.0 - 1.0 / math.sqrt(2.0)
 NEWTON_TOL = 1e-11      # Newton stops when no free node's position changes by more than this times l
@@ -122,7 +122,7 @@ class SdirkFamily(Integrator):
                              self.nodes, self.model.params, self.limits, self.schedule(n), frames)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     """Newton solve of one stage: X = xh + beta V, V = vh + beta (a(X, V) - gamma V). Returns
     (iterations, node, fluid power [W], internal-damping power [W]): iterations < 0 when it failed, naming the
@@ -186,7 +186,7 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     return -1, worst_node, 0.0, 0.0, 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, frames):
     """Advance ``schedule.n_steps`` SDIRK2 steps in place; the contract of :mod:`ropesim.integrate.base`.
 

@@ -24,11 +24,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from .banded import factor, solve, woodbury
 from .jacobian import Jacobian, band_width
 from .terms import accelerations, coupling_reach, newton_matrix
+from .jit import kernel
 
 TOL = 1e-10
 MAX_ITERATIONS = 2000
@@ -45,7 +45,7 @@ class Equilibrium:
     converged: bool
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def _forces(x, v, acc, p, t, mass, free, out):
     """The net static force [N] on every free node (0 on held nodes) into ``out`` (flat, node-major); returns
     its largest component."""

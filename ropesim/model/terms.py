@@ -25,7 +25,6 @@ Compiled entry points, each the term list in one form:
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
 
 from .forces.added_mass import ADDED_MASS_TERM, add_added_mass_jacobian, apply_added_mass
 from .forces.bending import EI_TERM, add_ei_bending, add_ei_jacobian, ei_energy
@@ -44,6 +43,7 @@ from .forces.seabed import (SEABED_TERM, add_seabed_contact, add_seabed_friction
 from .forces.thrower import THROWER as THROWER_TERM
 from .forces.thrower import add_thrower, add_thrower_jacobian
 from .jacobian import pair_damper_blocks, pair_spring_blocks
+from .jit import kernel
 
 TERMS = (ROPE, BENDING_TERM, GRAVITY_TERM, BUOYANCY_TERM, THROWER_TERM, GUIDES_TERM, AXIAL_DAMPING_TERM,
          FLUID_DRAG_TERM, VISCOUS_DRAG_TERM, BODY_DRAG_TERM, FLOW_TERM, FLOW_PUSH_TERM, ADDED_MASS_TERM, SEABED_TERM,
@@ -100,20 +100,20 @@ def has_applied(p: ModelParams) -> bool:
     return bool(p.flags[THROWER] or p.flags[GUIDES])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def any_applied(flags):
     """True when a term of the ledger's ``box_work`` (the thrower, the guides) is on."""
     return flags[THROWER] != 0 or flags[GUIDES] != 0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def any_fluid(flags):
     """True when a term acting through the fluid (drag on the relative velocity, a flow's push) is on."""
     return (flags[FLUID_DRAG] != 0 or flags[VISCOUS_DRAG] != 0 or flags[BODY_DRAG] != 0
             or flags[FLOW_PUSH] != 0)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def position_accelerations(x, acc, p):
     """Overwrite ``acc`` (D, N) with the acceleration [m/s^2] of the terms that depend on positions alone."""
     closed = p.spring[2] != 0.0
@@ -129,7 +129,7 @@ def position_accelerations(x, acc, p):
         add_ei_bending(x, acc, p.inv_mass, p.bending_ei, closed)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def velocity_accelerations(x, v, acc, p, t):
     """Add the acceleration [m/s^2] of the terms that depend on velocities (the thrower, the guides, axial
     damping, fluid forces, the seabed's damping and friction) at time t [s]; returns the power [W] of the
@@ -152,7 +152,7 @@ def velocity_accelerations(x, v, acc, p, t):
     return fluid, internal, seabed
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def accelerations(x, v, acc, p, t):
     """Overwrite ``acc`` (D, N) with every term's force / m [m/s^2] at time t [s], the linear [drag] b v and
     added mass excluded; returns the power [W] of the fluid, the axial damping and the seabed."""
@@ -160,7 +160,7 @@ def accelerations(x, v, acc, p, t):
     return velocity_accelerations(x, v, acc, p, t)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def added_mass(x, v, acc, p):
     """With added mass on, turn ``acc`` (every force / m, drag included) into M^-1 F; returns the power [W] of
     the fluid's inertial force (0 without added mass)."""
@@ -169,7 +169,7 @@ def added_mass(x, v, acc, p):
     return 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def applied_accelerations(x, v, out, p):
     """Overwrite ``out`` (D, N) with the non-conservative terms' part of the acceleration [m/s^2] alone (the
     thrower's and guides'); zero when none is on. The energy ledger books their work as ``box_work``."""
@@ -181,7 +181,7 @@ def applied_accelerations(x, v, out, p):
         add_guides(x, v, out, p.guides, p.thrower, p.flags[THROWER] != 0, g)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def _springs_energy_and_stretch(x, k, rest, stride, closed, slack):
     dim, n = x.shape
     count = n if closed else n - stride
@@ -205,7 +205,7 @@ def _springs_energy_and_stretch(x, k, rest, stride, closed, slack):
     return energy, worst / rest, where
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def mechanical_energy(x, v, mass, p):
     """(kinetic + spring + bending + gravitational + buoyancy energy [J], largest spring length / rest length,
     its node). Checked every few steps by the run loop to catch a blow-up (runaway energy or an insane
@@ -231,7 +231,7 @@ def mechanical_energy(x, v, mass, p):
     return e, stretch, node
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def coupling_jacobian(x, jac, beta, free, p):
     """Add the coupling terms' blocks for a stage of coefficient beta = gamma h: beta^2 times the springs' and
     bending's stiffness, beta times the axial damping."""
@@ -246,7 +246,7 @@ def coupling_jacobian(x, jac, beta, free, p):
         add_ei_jacobian(x, jac, beta, free, p.bending_ei, p.spring[1], closed)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def node_jacobian(x, v, band, beta, mass, free, p, t):
     """Add the node-local terms' blocks (the thrower's, the guides', the fluid's, added mass) to the Newton
     matrix's ``band``, for a stage of coefficient beta = gamma h at time t (see :mod:`ropesim.model.jacobian`)."""
@@ -262,7 +262,7 @@ def node_jacobian(x, v, band, beta, mass, free, p, t):
         add_seabed_jacobian(x, v, band, beta, free, p.seabed, True)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def newton_matrix(x, v, jac, beta, nodes, p, t):
     """The matrix M (1 + beta gamma) + beta^2 H + beta C_v into ``jac`` (:mod:`ropesim.model.jacobian`): the
     mass and linear drag on the diagonal, then every term's blocks. ``nodes`` = (free (N,) bool, mass (N,),

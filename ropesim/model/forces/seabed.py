@@ -25,22 +25,22 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from . import Term
 from .fluid import node_tangent
+from ..jit import kernel
 
 SEABED = 12   # its flag
 SEABED_PARAMS = 9
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def depth(px, py, bed):
     """How far a point is sunk below the plane along its normal [m] (negative above it)."""
     return (bed[0] + bed[1] * px - py) * bed[2]
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_seabed_contact(x, acc, inv_mass, seabed):
     """Add the contact spring's acceleration k delta A n / m [m/s^2] of every node in contact."""
     bed, area = seabed
@@ -54,7 +54,7 @@ def add_seabed_contact(x, acc, inv_mass, seabed):
             acc[1, i] += f * ny
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_seabed_friction(x, v, acc, inv_mass, seabed, closed):
     """Add the contact damping and friction (see the module doc) as accelerations; returns their power [W]."""
     bed, area = seabed
@@ -95,7 +95,7 @@ def add_seabed_friction(x, v, acc, inv_mass, seabed, closed):
     return power
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def seabed_energy(x, seabed):
     """The contact springs' energy, sum of k delta^2 A / 2 [J]."""
     bed, area = seabed
@@ -107,7 +107,7 @@ def seabed_energy(x, seabed):
     return e
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_seabed_jacobian(x, v, band, beta, free, seabed, friction):
     """Add each contact's node block to the Newton matrix (:mod:`ropesim.model.jacobian`): beta^2 k A n n^T
     and beta c A n n^T, and with ``friction`` beta mu N / sqrt(|v_s|^2 + v_reg^2) across the normal (the

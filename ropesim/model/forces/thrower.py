@@ -15,15 +15,15 @@ Parameters, packed in one float64 array: cx, cy, cz, L/2, W/2, v_max, b_thrower,
 import math
 
 import numpy as np
-from numba import njit
 
 from . import Term
+from ..jit import kernel
 
 THROWER_PARAMS = 10
 SMOOTH_CUTOFF = 20.0  # beyond 20 widths tanh is 1 to double precision: the weight is exactly 0 or 1
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def smooth_step(d, w):
     """The indicator of d > 0, smoothed over a width w: (1 + tanh(d / w)) / 2; the sharp step when w = 0."""
     if w == 0.0:
@@ -36,7 +36,7 @@ def smooth_step(d, w):
     return 0.5 * (1.0 + math.tanh(z))
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def box_of(p):
     """The box's centre, half-length, half-width and edge width (cx, cy, cz, L/2, W/2, w), a tuple of floats.
 
@@ -47,7 +47,7 @@ def box_of(p):
     return p[0], p[1], p[2], p[3], p[4], p[9]
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def weight_at(px, py, pz, three_d, box):
     """How much a node at (px, py[, pz]) is inside the box ``box`` (see :func:`box_of`), 0 to 1 (exactly 0 or 1
     with sharp edges); ``pz`` is ignored unless ``three_d``."""
@@ -64,14 +64,14 @@ def weight_at(px, py, pz, three_d, box):
     return s
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def box_weight(x, i, p):
     """How much node i is inside the box, 0 to 1 (exactly 0 or 1 with sharp edges)."""
     three_d = x.shape[0] == 3
     return weight_at(x[0, i], x[1, i], x[2, i] if three_d else 0.0, three_d, box_of(p))
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def inside_box(x, i, p):
     """True when node i lies inside the box described by ``p`` (its sharp edges, whatever the edge width)."""
     three_d = x.shape[0] == 3
@@ -80,7 +80,7 @@ def inside_box(x, i, p):
     return weight_at(x[0, i], x[1, i], x[2, i] if three_d else 0.0, three_d, sharp) > 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_thrower(x, v, acc, inv_mass, p, g):
     """Add the box's drive and centring accelerations [m/s^2] to every node inside it."""
     n = x.shape[1]
@@ -99,7 +99,7 @@ def add_thrower(x, v, acc, inv_mass, p, g):
 
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_thrower_jacobian(x, band, beta, mass, free, p):
     """Add the box's node blocks to the stiff integrator's Newton matrix (see :mod:`ropesim.model.jacobian`).
 
