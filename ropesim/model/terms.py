@@ -31,6 +31,7 @@ from .forces.bending import EI_TERM, add_ei_bending, add_ei_jacobian, ei_energy
 from .forces.buoyancy import BUOYANCY_TERM, add_buoyancy
 from .forces.fluid import (BODY_DRAG_TERM, FLOW_PUSH_TERM, FLOW_TERM, FLUID_DRAG_TERM, VISCOUS_DRAG_TERM,
                            add_fluid_forces, add_fluid_jacobian)
+from .forces.flow_inertia import FLOW_INERTIA_TERM, add_flow_inertia
 from .forces.gravity import GRAVITY as GRAVITY_TERM
 from .forces.guides import GUIDES as GUIDES_TERM
 from .forces.guides import add_guides, add_guides_jacobian
@@ -47,19 +48,20 @@ from .jit import kernel
 
 TERMS = (ROPE, BENDING_TERM, GRAVITY_TERM, BUOYANCY_TERM, THROWER_TERM, GUIDES_TERM, AXIAL_DAMPING_TERM,
          FLUID_DRAG_TERM, VISCOUS_DRAG_TERM, BODY_DRAG_TERM, FLOW_TERM, FLOW_PUSH_TERM, ADDED_MASS_TERM, SEABED_TERM,
-         EI_TERM)
+         EI_TERM, FLOW_INERTIA_TERM)
 
 # Positions in ModelParams.flags (uint8), one per optional term: each Term's ``flag``.
 BENDING, GRAVITY, THROWER, GUIDES = BENDING_TERM.flag, GRAVITY_TERM.flag, THROWER_TERM.flag, GUIDES_TERM.flag
 AXIAL_DAMPING, BUOYANCY = AXIAL_DAMPING_TERM.flag, BUOYANCY_TERM.flag
 FLUID_DRAG, VISCOUS_DRAG, BODY_DRAG = FLUID_DRAG_TERM.flag, VISCOUS_DRAG_TERM.flag, BODY_DRAG_TERM.flag
 FLOW, FLOW_PUSH, ADDED_MASS = FLOW_TERM.flag, FLOW_PUSH_TERM.flag, ADDED_MASS_TERM.flag
-SEABED, EI_BENDING = SEABED_TERM.flag, EI_TERM.flag
-N_FLAGS = 14
+SEABED, EI_BENDING, FLOW_INERTIA = SEABED_TERM.flag, EI_TERM.flag, FLOW_INERTIA_TERM.flag
+N_FLAGS = 15
 
 ModelParams = namedtuple("ModelParams", [
     "inv_mass", "flags", "node_length", "spring", "bending", "gravity", "buoyancy", "thrower", "guides", "axial",
-    "fluid_drag", "viscous_drag", "body_drag", "flow", "flow_push", "added_mass", "seabed", "bending_ei"])
+    "fluid_drag", "viscous_drag", "body_drag", "flow", "flow_push", "added_mass", "seabed", "bending_ei",
+    "flow_inertia"])
 """What the compiled code knows of the model's forces: 1 / m per node (N,), the on/off flags (N_FLAGS,), each
 node's share of unstretched length (N,) [m], and each term's parameters, in TERMS order (see each term's
 module for its layout)."""
@@ -131,9 +133,9 @@ def position_accelerations(x, acc, p):
 
 @kernel
 def velocity_accelerations(x, v, acc, p, t):
-    """Add the acceleration [m/s^2] of the terms that depend on velocities (the thrower, the guides, axial
-    damping, fluid forces, the seabed's damping and friction) at time t [s]; returns the power [W] of the
-    fluid, of the axial damping and of the seabed."""
+    """Add the acceleration [m/s^2] of the terms that depend on velocities or time (the thrower, the guides,
+    axial damping, fluid forces, the accelerating water's, the seabed's damping and friction) at time t [s];
+    returns the power [W] of the fluid, of the axial damping and of the seabed."""
     closed = p.spring[2] != 0.0
     g = p.gravity[0] if p.flags[GRAVITY] else 0.0
     if p.flags[THROWER]:
@@ -146,6 +148,8 @@ def velocity_accelerations(x, v, acc, p, t):
     fluid = 0.0
     if any_fluid(p.flags):
         fluid = add_fluid_forces(x, v, acc, p, t)
+    if p.flags[FLOW_INERTIA]:
+        fluid += add_flow_inertia(x, v, acc, p.inv_mass, p.flow_inertia, p.flow, t, closed)
     seabed = 0.0
     if p.flags[SEABED]:
         seabed = add_seabed_friction(x, v, acc, p.inv_mass, p.seabed, closed)

@@ -403,8 +403,11 @@ def _check_fluid(scene: S.Scene, fail) -> None:
     if scene.buoyancy is not None and scene.gravity is None:
         fail("buoyancy", "needs [gravity]: buoyancy is the fluid's weight displaced")
     drags = [k for k in ("drag", "fluid_drag", "viscous_drag") if getattr(scene, k) is not None]
-    if scene.flow is not None and not drags and not any(b.cd_area > 0 for b in scene.bodies):
-        fail("flow", "moves the rope only through drag: add [drag], [fluid_drag], [viscous_drag] or a body "
+    inertia = scene.flow is not None and scene.flow.ramp_time > 0 and (
+        scene.buoyancy is not None or scene.added_mass is not None or any(b.ca > 0 for b in scene.bodies))
+    if scene.flow is not None and not drags and not inertia and not any(b.cd_area > 0 for b in scene.bodies):
+        fail("flow", "moves the rope only through drag (and, while it ramps in, through buoyancy or added "
+                     "mass): add [drag], [fluid_drag], [viscous_drag] or a body "
                      "with cd_area")
     flow = scene.flow
     if flow is not None:

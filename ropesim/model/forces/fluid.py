@@ -52,7 +52,13 @@ def ramp(t, ramp_time):
 @kernel
 def flow_at(y, t, flow, table):
     """The flow velocity (Ux, Uy, Uz) [m/s] at height y [m] and time t [s] (see the module doc)."""
-    s = ramp(t, flow[1])
+    return flow_scaled(y, ramp(t, flow[1]), flow, table)
+
+
+@kernel
+def flow_scaled(y, s, flow, table):
+    """The flow's full profile at height y [m] times s: its velocity with s the ramp's factor, its local
+    acceleration with s the ramp's rate."""
     kind = int(flow[0])
     if kind == TABLE:
         k = table.shape[0]
