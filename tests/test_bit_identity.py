@@ -86,8 +86,17 @@ def run_case(scene) -> dict:
             "force_evaluations": outcome.force_evaluations}
 
 
-CASES = [(name, method) for name in [p.stem for p in sorted(SCENARIOS.glob("*.toml"))]
-         + ["shooter_medium_smooth", *EXTRA] for method in METHODS]
+RECORDED = json.loads((DATA / "index.json").read_text())
+# A built-in scene added after the recording has no recorded runs: it is left out here (its own tests guard its
+# numbers, e.g. tests/test_string_shooter.py); every recorded run is still checked (see the test below).
+ALL_CASES = [(name, method) for name in [p.stem for p in sorted(SCENARIOS.glob("*.toml"))]
+             + ["shooter_medium_smooth", *EXTRA] for method in METHODS]
+CASES = [(name, method) for name, method in ALL_CASES if f"{name}__{method}" in RECORDED]
+
+
+def test_every_recorded_run_is_checked():
+    assert sorted(f"{name}__{method}" for name, method in CASES) == sorted(RECORDED)
+    assert len(CASES) == 72
 
 
 @pytest.fixture(scope="module")
@@ -123,7 +132,7 @@ def record() -> None:
     DATA.mkdir(parents=True, exist_ok=True)
     index = {}
     cases = scenes()
-    for name, method in CASES:
+    for name, method in ALL_CASES:
         got = run_case(with_method(cases[name], method))
         key = f"{name}__{method}"
         np.savez_compressed(DATA / f"{key}.npz", **{a: got[a] for a in ("t", "x", "v", "ledger")})
