@@ -425,7 +425,7 @@ def main() -> None:
     rows: list[dict] = []
     if args.quick:
         t_end = 0.05
-        cases = [dict(length=1.0, angle=30.0, cd_t=0.02, v_max=v, t_end=t_end) for v in (8.0, 24.0)]
+        cases = [dict(length=CDT_LENGTH, angle=CDT_ANGLE, cd_t=0.02, v_max=v, t_end=t_end) for v in (8.0, 24.0)]
         steps = 0
     else:
         t_end = T_END

@@ -136,3 +136,20 @@ def test_slow_and_level_the_loop_hangs_below_the_wheels():
 def test_without_tangential_drag_the_loop_does_not_stand_up():
     state = loop_state("fluid_drag.cd_tangential=0")
     assert not (state["inclination_deg"] > 45 and state["height_sd_over_length"] < 0.01)
+
+
+@pytest.mark.slow
+def test_the_study_script_runs_and_writes_its_tables_and_figures(tmp_path):
+    import subprocess
+    import sys
+
+    result = subprocess.run([sys.executable, str(ROOT / "scripts" / "string_shooter_takeoff.py"), "--quick",
+                             "--jobs", "1", "--out", str(tmp_path / "out"), "--figures", str(tmp_path / "fig")],
+                            capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr
+    assert "2 runs in" in result.stdout
+    for name in ("runs.csv", "takeoff.csv", "takeoff.md", "shapes.npz"):
+        assert (tmp_path / "out" / name).is_file(), name
+    assert len(list((tmp_path / "out" / "cases").glob("*.npz"))) == 2    # the cache a rerun picks up
+    for name in ("string_shooter_takeoff.png", "string_shooter_cdt.png", "string_shooter_shapes.png"):
+        assert (tmp_path / "fig" / name).stat().st_size > 10_000, name
