@@ -83,6 +83,9 @@ def print_summary(summary: dict, folder: Path) -> None:
         rows.append(("loop inclination", f"{shooter['loop_inclination_deg']:.1f} deg from vertical at t_end "
                                          f"(mean {shooter['mean_loop_inclination_deg']:.1f} deg over the last "
                                          f"{shooter['averaged_over_s']:.3g} s)"))
+        if "mean_centroid_height_m" in shooter:
+            rows.append(("loop height", f"centroid {shooter['centroid_height_m']:.3g} m above the thrower's centre "
+                                        f"at t_end (mean {shooter['mean_centroid_height_m']:.3g} m)"))
     tension = summary.get("tension")
     if tension:
         rows.append(("tension", f"{tension['start_N']:.4g} N at node 0's end, {tension['end_N']:.4g} N at the "
@@ -143,7 +146,8 @@ def print_check(scene: Scene, source: Path) -> None:
     if model.has_drag:
         terms.append(f"drag (b = {scene.drag.b if scene.drag else 0:g} kg/s)")
     if scene.thrower:
-        terms.append(f"thrower (v_max = {scene.thrower.v_max:g} m/s)")
+        angle = f", launch angle {scene.thrower.angle:g} deg" if scene.thrower.angle else ""
+        terms.append(f"thrower (v_max = {scene.thrower.v_max:g} m/s{angle})")
     if scene.guides:
         terms.append(f"{len(scene.guides)} guide circle{'s' if len(scene.guides) > 1 else ''}")
     if rope.axial_damping:

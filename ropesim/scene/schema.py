@@ -412,6 +412,10 @@ class Thrower:
     Inside it a node feels F_x = b_thrower (v_max - v_x) along the box, and across it a critically damped
     spring towards the centre line that also cancels gravity: F_y = m g - m omega0^2 (y - cy)
     - 2 zeta m omega0 v_y (likewise in z). omega0 defaults to 2 (2 pi v_max / L).
+
+    ``angle`` (the launch angle alpha) turns the box and its drive about its centre in the x-y plane, positive
+    upward (counter-clockwise): the drive then acts along (cos alpha, sin alpha) and the centring spring across
+    it, while the weight is still cancelled along y. The guide circles are not moved: place them yourself.
     """
 
     center: tuple = spec("vector", "centre of the box", "m")
@@ -425,6 +429,14 @@ class Thrower:
                                 low=0)
     edge_width: float = spec("float", "width w over which the box's edges switch its forces on (0 = sharp)", "m",
                              default=0.0, low=0)
+    angle: float = spec("float", "launch angle: the box and its drive turned about its centre in the x-y plane, "
+                                 "positive upward (0 = along +x)", "deg", default=0.0, low=-90, high=90)
+
+    @property
+    def direction(self) -> tuple[float, float]:
+        """(cos alpha, sin alpha): the drive's direction in the x-y plane ((1.0, 0.0) exactly at angle 0)."""
+        alpha = math.radians(self.angle)
+        return math.cos(alpha), math.sin(alpha)
 
     @property
     def resolved_omega0(self) -> float:
