@@ -690,3 +690,13 @@ toml_lines = st.one_of(
 @given(st.lists(toml_lines, max_size=12))
 def test_random_toml_ish_text_never_crashes(lines):
     _accepted_or_one_line("\n".join(lines))
+
+
+def test_a_scene_error_survives_pickling():
+    """A sweep's worker process raises it in another process: the message must arrive whole."""
+    import pickle
+
+    error = SceneError("a.toml", "rope.mass", "must be a number > 0, got -1")
+    again = pickle.loads(pickle.dumps(error))
+    assert isinstance(again, SceneError) and str(again) == str(error) == "a.toml: rope.mass: must be a number > 0, got -1"
+    assert (again.source, again.key, again.message) == (error.source, error.key, error.message)

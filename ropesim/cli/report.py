@@ -196,15 +196,19 @@ def stability_rows(model, method: str, dt: float) -> list[tuple[str, str]]:
         return [("fastest mode", "no free node: nothing to integrate")]
     out = [("fastest mode", f"omega_max <= {s:.4g} rad/s (largest eigenvalue of the mass-weighted spring "
                             f"stiffness); Gershgorin bound {g:.4g} rad/s")]
+    scene = model.scene
     damping = explicit_damping(model)
     if damping > 0:
-        out.append(("explicit damping", f"{damping:.4g} 1/s (thrower and guides' velocity terms, evaluated "
-                                        f"explicitly: they shorten the explicit methods' steps)"))
+        from ..model.terms import declared_terms
+
+        rates = {term.name: term.damping(model) for term in declared_terms(scene)}
+        names = ", ".join(name for name, rate in rates.items() if rate > 0)
+        out.append(("velocity damping", f"up to {damping:.4g} 1/s ({names}); the bounds below include it where "
+                                        f"a method evaluates it explicitly"))
     high = drag_rates(model)[1]
     if high > 0:
         out.append(("drag", f"b/m up to {high:.4g} 1/s: exact in the splitting schemes' kicks, explicit in rk4, "
                             f"implicit in sdirk2"))
-    scene = model.scene
     sharp = [name for name, part in (("thrower", scene.thrower), *(("guides", g) for g in scene.guides))
              if part is not None and part.edge_width == 0]
     if sharp:

@@ -29,6 +29,9 @@ class SceneError(ValueError):
         where = f"{source}: {key}: " if key else f"{source}: "
         super().__init__(" ".join(f"{where}{message}".split()))
 
+    def __reduce__(self):   # picklable, so a sweep's worker process hands the real message back
+        return SceneError, (self.source, self.key, self.message)
+
 
 def load_scene(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> S.Scene:
     """Load and validate a scene file, or a built-in scene by name ("helicopter_mass"; a file that exists
