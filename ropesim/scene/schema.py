@@ -378,9 +378,10 @@ class Driven:
     ``period`` T, ``phase`` phi in degrees; an axis with A = 0 stays still) and a piecewise-linear ``path`` p(t)
     read from a CSV file of rows t, dx, dy[, dz] or given inline as ``path_table`` (displacements, p(0) = 0,
     times increasing and covering the run; the loader reads the file into ``path_table``, so a resolved scene
-    carries its path with it), both ramped in by r(t) = (1 - cos(pi t / ramp_time)) / 2 until ``ramp_time`` (1 from then on, or
-    always when it is 0). The node's velocity and acceleration follow; the force its support exerts is
-    reported (``support`` in each saved frame).
+    carries its path with it), both ramped in by r(t) = 10 s^3 - 15 s^4 + 6 s^5, s = t / ``ramp_time``, until
+    ``ramp_time`` (1 from then on, or always when it is 0; its rate and acceleration vanish at both ends, so
+    the motion starts and settles without a jolt). The node's velocity and acceleration follow; the force its
+    support exerts is reported (``support`` in each saved frame).
     """
 
     nodes: tuple = spec("int_list", "indices of the driven nodes (negative counts from the end)")
