@@ -109,9 +109,10 @@ class Rope:
 class Seabed:
     """A seabed or ground: the plane y = height + tan(slope) x, with the scene's nodes pushed out of it.
 
-    A node that sinks a depth delta below the plane (measured along its normal n) feels
-    (k delta - c v_n) A along n, A = contact_width x L (its share of unstretched length), with the contact
-    stiffness k and damping c per unit area (MoorDyn's kBot and cBot; MoorDyn's defaults). Sliding on it, the
+    A node that sinks a depth delta below the plane (measured along its normal n) feels k delta A along n,
+    A = contact_width x L (its share of unstretched length), plus the damping c |v_n| A while it moves into the
+    plane (none while it moves out: the seabed is not sticky), grown in over the first 1e-3 footprint widths
+    of depth; the contact stiffness k and damping c per unit area are MoorDyn's kBot and cBot (its defaults). Sliding on it, the
     node feels Coulomb-like friction against its sliding velocity v_s (v minus its normal part), split along
     and across the rope (the node tangent projected on the plane):
 
