@@ -28,6 +28,7 @@ from rich.console import Console
 from rich.table import Table
 
 import ropesim
+from ropesim.analysis.stability import predicted_dt
 from ropesim.integrate.grid import TimeGrid
 from ropesim.integrate.methods import make_integrator
 from ropesim.model.build import build
@@ -59,9 +60,10 @@ CASES = {   # label: (scene, method, terms declared but inert)
 
 def integrator(scene_name: str, method: str, sets: list[str], steps: int, repeats: int):
     """A warmed-up integrator of the built-in scene with ``sets`` applied, long enough for every timed call."""
-    dt = ropesim.load_scene(ROOT / "scenarios" / f"{scene_name}.toml").integrator.dt
-    if method != "sdirk2":
-        dt = min(dt, 1e-3)   # the explicit methods at a step every scene is stable at
+    as_filed = ropesim.load_scene(ROOT / "scenarios" / f"{scene_name}.toml")
+    dt = as_filed.integrator.dt
+    if method != "sdirk2":   # the explicit methods at half their largest stable step, and at most the scene's
+        dt = min(dt, 0.5 * predicted_dt(build(as_filed), method))
     scene = ropesim.load_scene(ROOT / "scenarios" / f"{scene_name}.toml",
                                sets + [f"integrator.method={method}", f"integrator.dt={dt!r}",
                                        f"integrator.t_end={dt * steps * (repeats + 2)!r}"])
