@@ -99,6 +99,38 @@ class RungeKuttaFamily(Integrator):
 
 
 @kernel
+def stage_state(x, v, kx, kv, a, st, h, xs, vs):
+    """Stage ``st``'s state into ``xs``, ``vs``: x + h sum_j a[st, j] kx[j], and the same for v."""
+    dim, n = x.shape
+    for d in range(dim):
+        for i in range(n):
+            px = x[d, i]
+            pv = v[d, i]
+            for j in range(st):
+                w = a[st, j] * h
+                if w != 0.0:
+                    px += w * kx[j, d, i]
+                    pv += w * kv[j, d, i]
+            xs[d, i] = px
+            vs[d, i] = pv
+
+
+@kernel
+def combine(x, v, kx, kv, b, h):
+    """The step's end: x += h sum_s b[s] kx[s], and the same for v."""
+    dim, n = x.shape
+    for d in range(dim):
+        for i in range(n):
+            dx = 0.0
+            dv = 0.0
+            for st in range(b.shape[0]):
+                dx += b[st] * kx[st, d, i]
+                dv += b[st] * kv[st, d, i]
+            x[d, i] += h * dx
+            v[d, i] += h * dv
+
+
+@kernel
 def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedule, frames):
     """Advance ``schedule.n_steps`` Runge-Kutta steps in place; the contract of :mod:`ropesim.integrate.base`.
 
@@ -118,17 +150,7 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
         step = schedule.step0 + s
         t = step * h
         for st in range(stages):
-            for d in range(dim):
-                for i in range(n):
-                    px = x[d, i]
-                    pv = v[d, i]
-                    for j in range(st):
-                        w = a[st, j] * h
-                        if w != 0.0:
-                            px += w * kx[j, d, i]
-                            pv += w * kv[j, d, i]
-                    xs[d, i] = px
-                    vs[d, i] = pv
+            stage_state(x, v, kx, kv, a, st, h, xs, vs)
             place(xs, vs, held, t + c[st] * h)
             for j in range(held_idx.shape[0]):
                 for d in range(dim):
@@ -154,15 +176,7 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
             if has_box:
                 applied_accelerations(xs, vs, acc_box, params)
                 ledger[BOX] += wh * power(acc_box, vs, mass)
-        for d in range(dim):
-            for i in range(n):
-                dx = 0.0
-                dv = 0.0
-                for st in range(stages):
-                    dx += b[st] * kx[st, d, i]
-                    dv += b[st] * kv[st, d, i]
-                x[d, i] += h * dx
-                v[d, i] += h * dv
+        combine(x, v, kx, kv, b, h)
         place(x, v, held, (step + 1) * h)
         done = step + 1
         if not due(done, schedule):

@@ -127,14 +127,80 @@ class SdirkFamily(Integrator):
 
 
 @kernel
+def stage_residual(stage, rhs, beta, t_stage, held, nodes, params):
+    """At the stage's positions X, with V = (X - xh) / beta (held nodes: their own velocity), write minus the
+    residual of m (V - vh) = beta (a(X, V) m - b V) (plus A_i (V - vh) with added mass), times beta, into
+    ``rhs``. Returns (its squared norm, fluid, internal-damping and seabed power [W])."""
+    xh, vh, X, V, acc = stage.xh, stage.vh, stage.X, stage.V, stage.acc
+    held_idx, held_v = held.idx, held.v
+    free, mass, drag = nodes
+    dim, n = X.shape
+    inertial = params.flags[ADDED_MASS] != 0
+    closed = params.spring[2] != 0.0
+    for d in range(dim):
+        for i in range(n):
+            V[d, i] = (X[d, i] - xh[d, i]) / beta
+    for j in range(held_idx.shape[0]):
+        for d in range(dim):
+            V[d, held_idx[j]] = held_v[d, j]
+    fluid, internal, seabed = accelerations(X, V, acc, params, t_stage)
+    for i in range(n):
+        for d in range(dim):
+            u = i * dim + d
+            if free[i]:
+                m = mass[i]
+                rhs[u] = -((m + beta * drag[i]) * (X[d, i] - xh[d, i]) - beta * m * vh[d, i]
+                           - beta * beta * m * acc[d, i])
+            else:
+                rhs[u] = 0.0
+        if inertial and free[i]:   # + A_i (X - xh - beta vh)
+            w0 = X[0, i] - xh[0, i] - beta * vh[0, i]
+            w1 = X[1, i] - xh[1, i] - beta * vh[1, i]
+            w2 = X[2, i] - xh[2, i] - beta * vh[2, i] if dim == 3 else 0.0
+            extra = added_mass_times(X, i, w0, w1, w2, params.added_mass, closed)
+            for d in range(dim):
+                rhs[i * dim + d] -= extra[d]
+    norm = 0.0
+    for u in range(rhs.shape[0]):
+        norm += rhs[u] * rhs[u]
+    return norm, fluid, internal, seabed
+
+
+@kernel
+def take_update(X, rhs, step):
+    """X += the Newton update in ``rhs``, kept in ``step``. Returns (its largest component [m], that node)."""
+    dim, n = X.shape
+    worst = 0.0
+    worst_node = -1
+    for i in range(n):
+        for d in range(dim):
+            dx = rhs[i * dim + d]
+            step[i * dim + d] = dx
+            X[d, i] += dx
+            if not abs(dx) <= worst:
+                worst = abs(dx)
+                worst_node = i
+    return worst, worst_node
+
+
+@kernel
+def take_back_half(X, step):
+    """Halve the last update ``step`` and take that half back from X."""
+    dim, n = X.shape
+    for i in range(n):
+        for d in range(dim):
+            step[i * dim + d] *= 0.5
+            X[d, i] -= step[i * dim + d]
+
+
+@kernel
 def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     """Newton solve of one stage: X = xh + beta V, V = vh + beta (a(X, V) - gamma V). Returns
     (iterations, node, fluid power [W], internal-damping power [W]): iterations < 0 when it failed, naming the
     node that moved most in the last one. With added mass the stage's equation is M (V - vh) = beta (F - b V),
     M = m I + A per node (:mod:`ropesim.model.forces.added_mass`)."""
-    xh, vh, X, V, acc = stage.xh, stage.vh, stage.X, stage.V, stage.acc
-    held_idx, held_v = held.idx, held.v
-    free, mass, drag = nodes
+    xh, vh, X, V = stage.xh, stage.vh, stage.X, stage.V
+    free = nodes[0]
     band, rhs = newton.jac.band, newton.rhs
     dim, n = X.shape
     p = band.shape[0] - 1
@@ -143,48 +209,17 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
             X[d, i] = xh[d, i] + beta * vh[d, i]
     place(X, V, held, t_stage)
     worst_node = -1
-    inertial = params.flags[ADDED_MASS] != 0
-    closed = params.spring[2] != 0.0
-    step = newton.step
     last = np.inf            # the residual's norm before the last update
     stride = 0.0             # the last update's largest component [m]
     halvings = 0
     for it in range(NEWTON_MAX_ITER):
-        for d in range(dim):
-            for i in range(n):
-                V[d, i] = (X[d, i] - xh[d, i]) / beta
-        for j in range(held_idx.shape[0]):
-            for d in range(dim):
-                V[d, held_idx[j]] = held_v[d, j]
-        fluid, internal, seabed = accelerations(X, V, acc, params, t_stage)
-        for i in range(n):
-            for d in range(dim):
-                u = i * dim + d
-                if free[i]:
-                    m = mass[i]
-                    rhs[u] = -((m + beta * drag[i]) * (X[d, i] - xh[d, i]) - beta * m * vh[d, i]
-                               - beta * beta * m * acc[d, i])
-                else:
-                    rhs[u] = 0.0
-            if inertial and free[i]:   # + A_i (X - xh - beta vh)
-                w0 = X[0, i] - xh[0, i] - beta * vh[0, i]
-                w1 = X[1, i] - xh[1, i] - beta * vh[1, i]
-                w2 = X[2, i] - xh[2, i] - beta * vh[2, i] if dim == 3 else 0.0
-                extra = added_mass_times(X, i, w0, w1, w2, params.added_mass, closed)
-                for d in range(dim):
-                    rhs[i * dim + d] -= extra[d]
-        norm = 0.0
-        for u in range(rhs.shape[0]):
-            norm += rhs[u] * rhs[u]
+        norm, fluid, internal, seabed = stage_residual(stage, rhs, beta, t_stage, held, nodes, params)
         if norm > last and stride > BACKTRACK_ABOVE * newton.tol and halvings < MAX_HALVINGS:
             # the full step made the residual worse (a contact switching on, friction reversing): go back half
             # of it and look again; a smooth problem never gets here, so its iterates are Newton's own
             halvings += 1
             stride *= 0.5
-            for i in range(n):
-                for d in range(dim):
-                    step[i * dim + d] *= 0.5
-                    X[d, i] -= step[i * dim + d]
+            take_back_half(X, newton.step)
             continue
         last = norm
         halvings = 0
@@ -192,17 +227,8 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
         if not factor(band, newton.jac.corner, newton.cyclic, p, newton.wood):
             return -1, 0, 0.0, 0.0, 0.0
         solve(band, newton.jac.corner, newton.cyclic, p, rhs, newton.wood)
-        worst = 0.0
-        for i in range(n):
-            for d in range(dim):
-                dx = rhs[i * dim + d]
-                step[i * dim + d] = dx
-                X[d, i] += dx
-                if not abs(dx) <= worst:
-                    worst = abs(dx)
-                    worst_node = i
-        stride = worst
-        if worst <= newton.tol:
+        stride, worst_node = take_update(X, rhs, newton.step)
+        if stride <= newton.tol:
             for d in range(dim):
                 for i in range(n):
                     if free[i]:
