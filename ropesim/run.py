@@ -264,66 +264,78 @@ def resume(folder: str | Path, t_end: float | None = None, progress: bool = Fals
     wall times). Refused in one line (:class:`~ropesim.io.runfolder.RunFolderError`) when there is nothing to
     continue, when scene.toml was edited since, or when the new t_end would change the time grid.
     """
-    from dataclasses import replace
-
-    from .io.runfolder import (BLEW_UP as BLEW, COMPLETED as DONE, SCENE, RunFolderError, RunWriter, scene_hash)
-    from .scene.loader import SceneError, scene_from_toml
+    from .io.atomic import write_text_atomic
+    from .io.runfolder import SCENE, RunFolderError, RunWriter, scene_hash
     from .scene.schema import scene_to_toml
 
     folder = Path(folder)
     writer = RunWriter.reopen(folder)
     try:
-        m = writer.manifest
-        try:
-            text = (folder / SCENE).read_text(encoding="utf-8")
-            scene = scene_from_toml(text, source=str(folder / SCENE))
-        except (OSError, SceneError) as exc:
-            raise RunFolderError(f"{folder / SCENE}: cannot be read ({exc}); run the scene again") from None
-        if scene_hash(text) != m.get("scene_sha256"):
-            raise RunFolderError(f"{folder / SCENE}: changed since the run began, so the run cannot continue bit "
-                                 f"for bit; run the scene again (only --set integrator.t_end=... may change with "
-                                 f"--resume)")
-        old_t_end = scene.integrator.t_end
-        if t_end is not None and t_end != old_t_end:
-            scene = replace(scene, integrator=replace(scene.integrator, t_end=float(t_end)))
-        if m["status"] == BLEW:
-            raise RunFolderError(f"{folder}: blew up ({m.get('message', '')}); it cannot continue; run it again "
-                                 f"with a smaller integrator.dt")
-        if m["status"] == DONE and scene.integrator.t_end <= old_t_end:
-            raise RunFolderError(f"{folder}: already completed to t = {old_t_end:g} s; to extend it give "
-                                 f"--set integrator.t_end=T with T > {old_t_end:g}")
+        scene, old_t_end = _scene_to_continue(folder, writer.manifest, t_end)
         model = build(scene)
         grid = TimeGrid.of(scene)
-        old = m.get("grid", {})
+        old = writer.manifest.get("grid", {})
         if (grid.dt, grid.save_every) != (old.get("dt"), old.get("save_every")):
             raise RunFolderError(
                 f"{folder}: integrator.t_end = {scene.integrator.t_end:g} s changes the run's time grid (dt "
                 f"{old.get('dt')!r} -> {grid.dt!r} s, a frame every {old.get('save_every')} -> {grid.save_every} "
                 f"steps), so the result could not equal one uninterrupted run; choose t_end a whole number of "
                 f"dt = {old.get('dt')!r} s")
-        specs = frame_specs(model)
-        state, cp = writer.load_checkpoint(specs)
-        step = int(state["step"])
-        if step > grid.steps:
-            raise RunFolderError(f"{folder}: its last checkpoint is at t = {cp['t']:.6g} s, past the new t_end")
-        on_grid = 1 + step // grid.save_every + (1 if step == grid.steps and step % grid.save_every else 0)
-        if writer.count > on_grid:      # the shorter run's own last frame, off the longer run's grid
-            writer.drop_last_frames(on_grid)
-        elif writer.count != on_grid:
-            raise RunFolderError(f"{folder}: its checkpoint holds {writer.count} frames for step {step}, expected "
-                                 f"{on_grid}; run the scene again")
+        state, cp = writer.load_checkpoint(frame_specs(model))
+        _align_frames(folder, writer, grid, int(state["step"]), cp)
         if scene.integrator.t_end != old_t_end:
             new_text = scene_to_toml(scene)
-            from .io.atomic import write_text_atomic
-
             write_text_atomic(folder / SCENE, new_text)
-            m.update(_manifest_info(scene, grid), scene_sha256=scene_hash(new_text))
+            writer.manifest.update(_manifest_info(scene, grid), scene_sha256=scene_hash(new_text))
         integrator = make_integrator(model, grid)
         integrator.restore(state)
         return _run_in_folder(model, grid, writer, integrator, cp, progress, stop, checkpoint_seconds)
     except BaseException:
         writer.close()
         raise
+
+
+def _scene_to_continue(folder: Path, manifest: dict, t_end: float | None) -> tuple[Scene, float]:
+    """(the run's scene, with ``t_end`` if given; its t_end before) if the run in ``folder`` can go on."""
+    from dataclasses import replace
+
+    from .io.runfolder import BLEW_UP, COMPLETED, SCENE, RunFolderError, scene_hash
+    from .scene.loader import SceneError, scene_from_toml
+
+    try:
+        text = (folder / SCENE).read_text(encoding="utf-8")
+        scene = scene_from_toml(text, source=str(folder / SCENE))
+    except (OSError, SceneError) as exc:
+        raise RunFolderError(f"{folder / SCENE}: cannot be read ({exc}); run the scene again") from None
+    if scene_hash(text) != manifest.get("scene_sha256"):
+        raise RunFolderError(f"{folder / SCENE}: changed since the run began, so the run cannot continue bit "
+                             f"for bit; run the scene again (only --set integrator.t_end=... may change with "
+                             f"--resume)")
+    old_t_end = scene.integrator.t_end
+    if t_end is not None and t_end != old_t_end:
+        scene = replace(scene, integrator=replace(scene.integrator, t_end=float(t_end)))
+    if manifest["status"] == BLEW_UP:
+        raise RunFolderError(f"{folder}: blew up ({manifest.get('message', '')}); it cannot continue; run it again "
+                             f"with a smaller integrator.dt")
+    if manifest["status"] == COMPLETED and scene.integrator.t_end <= old_t_end:
+        raise RunFolderError(f"{folder}: already completed to t = {old_t_end:g} s; to extend it give "
+                             f"--set integrator.t_end=T with T > {old_t_end:g}")
+    return scene, old_t_end
+
+
+def _align_frames(folder: Path, writer, grid: TimeGrid, step: int, cp: dict) -> None:
+    """Make the checkpoint's frames those an uninterrupted run on ``grid`` holds after ``step``: an extended
+    run drops the shorter run's own last frame, which lies off its grid."""
+    from .io.runfolder import RunFolderError
+
+    if step > grid.steps:
+        raise RunFolderError(f"{folder}: its last checkpoint is at t = {cp['t']:.6g} s, past the new t_end")
+    on_grid = 1 + step // grid.save_every + (1 if step == grid.steps and step % grid.save_every else 0)
+    if writer.count > on_grid:
+        writer.drop_last_frames(on_grid)
+    elif writer.count != on_grid:
+        raise RunFolderError(f"{folder}: its checkpoint holds {writer.count} frames for step {step}, expected "
+                             f"{on_grid}; run the scene again")
 
 
 def _manifest_info(scene: Scene, grid: TimeGrid) -> dict:
