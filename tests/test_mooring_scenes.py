@@ -62,6 +62,18 @@ def test_the_scene_loads_checks_stable_and_runs(name, tmp_path):
     assert traj.t[-1] == pytest.approx(0.5) and np.all(np.isfinite(traj.x)) and np.all(np.isfinite(traj.tension))
 
 
+def test_check_names_the_seabed_the_bending_stiffness_the_clamp_and_the_motion():
+    """`ropesim check` lists every part these scenes use: it left out the seabed, rope.EI and the clamp, and
+    quoted the fairlead's constant velocity (0 m/s) for its surge and heave."""
+    chain = " ".join(invoke("check", "mooring_chain").stdout.split())   # the table's wrapping undone
+    assert "seabed (y = -50 m, kBot = 100000 N/m^3, cBot = 0 N s/m^3, friction 0.7)" in chain
+    assert "driven [-1] sinusoid x 3 m, 10 s; y 1.5 m, 10 s, 90 deg, ramped in over 20 s" in chain
+    beam = " ".join(invoke("check", "cantilever_beam").stdout.split())
+    assert "bending stiffness (EI = 2.4604e+06 N m^2)" in beam and "pinned [0] (clamped [0])" in beam
+    heli = " ".join(invoke("check", "helicopter_mass").stdout.split())
+    assert "driven [0] at [8.0, 0.0] m/s" in heli and "seabed" not in heli and "bending" not in heli
+
+
 # ------------------------------------------------------------------------------------- the chain
 
 
