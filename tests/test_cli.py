@@ -108,10 +108,10 @@ def test_trajectory_covers_zero_to_t_end(runs, name):
     assert np.all(np.isfinite(x)) and np.all(np.isfinite(v))
     for drive in scene.driven:  # driven nodes sit on x0 + V t (+ their ramped sinusoid) at every saved frame
         assert drive.path_table is None, "teach this test the path"
-        ramp = (np.where(t < drive.ramp_time, 0.5 * (1 - np.cos(np.pi * t / drive.ramp_time)), 1.0)
-                if drive.ramp_time > 0 else np.ones_like(t))
-        dramp = (np.where(t < drive.ramp_time, 0.5 * np.pi / drive.ramp_time * np.sin(np.pi * t / drive.ramp_time),
-                          0.0) if drive.ramp_time > 0 else np.zeros_like(t))
+        # the ramp r = 10 s^3 - 15 s^4 + 6 s^5, s = t / ramp_time (smootherstep), and its rate
+        s = np.minimum(t / drive.ramp_time, 1.0) if drive.ramp_time > 0 else np.ones_like(t)
+        ramp = s ** 3 * (10 - 15 * s + 6 * s ** 2)
+        dramp = 30 * s ** 2 * (1 - s) ** 2 / drive.ramp_time if drive.ramp_time > 0 else np.zeros_like(t)
         wave, dwave = np.zeros((frames, d)), np.zeros((frames, d))
         for axis in range(d) if drive.amplitude is not None else ():
             a, phase = drive.amplitude[axis], math.radians(drive.phase[axis])

@@ -183,7 +183,8 @@ def test_moving_chain_follows_its_fairlead_and_swings_wider_than_quasi_static():
     t, x = traj.t, traj.x
     (drive,) = s.driven
     x0 = np.asarray(s.initial.end)
-    ramp = np.where(t < drive.ramp_time, 0.5 * (1 - np.cos(np.pi * t / drive.ramp_time)), 1.0)
+    u = np.minimum(t / drive.ramp_time, 1.0)
+    ramp = u ** 3 * (10 - 15 * u + 6 * u ** 2)   # smootherstep
     for d in range(2):
         phase = math.radians(drive.phase[d])
         path = x0[d] + ramp * drive.amplitude[d] * (np.sin(2 * np.pi * t / drive.period[d] + phase) - math.sin(phase))

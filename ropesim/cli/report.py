@@ -311,3 +311,47 @@ def print_stability(result, folder: Path) -> None:
     if unstable:
         console.print(f"sdirk2 failed {len(unstable)} probes (Newton did not converge or the energy balance broke)")
     console.print(f"written: {folder}/ (stability.csv, bounds.csv, stability.png)")
+
+
+def print_equilibrium(shape, source: str) -> None:
+    """The static shape's figures (:class:`ropesim.analysis.statics.StaticShape`) as one table."""
+    import numpy as np
+
+    model, x = shape.model, shape.x
+    scene = model.scene
+    verdict = (f"static shape found in {shape.iterations} iterations" if shape.converged
+               else f"NOT converged after {shape.iterations} iterations")
+    table = Table(title=f"{source}: {verdict}", show_header=False, title_justify="left")
+    table.add_column("", style="bold")
+    table.add_column("", overflow="fold")
+    table.add_row("residual", f"largest force left on a free node {shape.residual:.3g} N "
+                              f"({shape.residual / shape.scale:.2g} of the largest force a term puts on a node, "
+                              f"{shape.scale:.4g} N)")
+    axes = "xyz"[:model.dim]
+    for node, force in zip(shape.held, shape.supports):
+        kind = "pinned" if scene.pinned and node in {scene.node(i) for i in scene.pinned.nodes} else "driven"
+        parts = ", ".join(f"F{a} = {f:.6g}" for a, f in zip(axes, force))
+        table.add_row(f"support, node {node}", f"{kind} at {_point(x[node])} m: {parts} N, "
+                                               f"|F| = {float(np.linalg.norm(force)):.6g} N")
+    tension = shape.tension
+    if tension.size:
+        k = int(np.argmax(tension))
+        slack = int(np.count_nonzero(tension <= 0.0))
+        table.add_row("tension", f"first segment {tension[0]:.6g} N, last segment {tension[-1]:.6g} N, largest "
+                                 f"{tension[k]:.6g} N in segment {k}" + (f"; {slack} slack" if slack else ""))
+    if scene.seabed is not None:
+        if shape.grounded.size:
+            where = (f"; touchdown at node {shape.touchdown}, {_point(x[shape.touchdown])} m"
+                     if shape.touchdown is not None else "")
+            table.add_row("seabed", f"{shape.grounded.size} nodes rest on it, carrying {shape.grounded_length:.6g} "
+                                    f"m of rope{where}")
+        else:
+            table.add_row("seabed", "no node touches it")
+    span = x[-1] - x[0]
+    table.add_row("ends", f"node 0 at {_point(x[0])} m, the last node "
+                          f"{', '.join(f'{a} {d:+.6g}' for a, d in zip(axes, span))} m from it")
+    _console().print(table)
+
+
+def _point(p) -> str:
+    return "(" + ", ".join(f"{float(c):.6g}" for c in p) + ")"

@@ -323,7 +323,7 @@ def _check_seabed(scene: S.Scene, fail) -> None:
                                      "it, or rope.diameter")
     from .shapes import initial_positions
 
-    x = initial_positions(scene)
+    x = initial_positions(scene)   # the held nodes where the scene puts them (the sagging guess keeps its ends)
     slope = math.radians(bed.slope)
     below = (bed.height + math.tan(slope) * x[0] - x[1]) * math.cos(slope)
     held = set(scene.pinned.nodes if scene.pinned else ()) | {i for d in scene.driven for i in d.nodes}
@@ -385,6 +385,13 @@ def _resolve_rope(rope: S.Rope, source: str) -> S.Rope:
         if given is not None and not _agree(given, value):
             fail(key, f"{given:g} contradicts the physical form, which gives {value:g}; give one form, or both "
                       f"consistently")
+    origin = {"segment_length": ("length", "length / segments"), "stiffness": ("EA", "EA / l"),
+              "mass": ("mass_per_length", "mass_per_length x l")}
+    for key, (physical, how) in origin.items():   # the derived per-node values obey the per-node keys' limits
+        value, spec = derived[key], {f.name: f.metadata["spec"] for f in fields(S.Rope)}[key]
+        if not MIN_POSITIVE <= value <= MAX_MAGNITUDE:
+            fail(physical, f"gives {key} = {how} = {value:g}{_unit(spec)}, outside {MIN_POSITIVE:g} to "
+                           f"{MAX_MAGNITUDE:g} (its products and ratios would overflow)")
     return replace(rope, segments=segments, mass_per_length=per_metre,
                    compression=False if rope.compression is None else rope.compression, **derived)
 
