@@ -2,9 +2,10 @@
 # Regenerate the docs' pictures of the built-in scenarios (docs/images/scenarios/) with ropesim's own
 # commands: the towed ropes as overlaid frames seen from the helicopter, run long enough to reach their steady
 # shapes (plus the plot of the one with the end mass), the string shooters as small GIFs of their default runs
-# (the real one, string_shooter_real, slowed down, with a frame sheet).
+# (the real one, string_shooter_real, slowed down, with a frame sheet), and the moorings and the beam (frames,
+# the chain's swing as a GIF, and each one's plot with its tensions).
 #
-#     scripts/make_readme_images.sh        # about a minute on two cores; prints the pictures' total size
+#     scripts/make_readme_images.sh        # about a minute and a half on two cores; prints the pictures' total size
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=docs/images/scenarios
@@ -37,4 +38,20 @@ ropesim animate "$runs/string_shooter_real" --fps 20 --speed 0.25 --end 1.5 --si
     -o "$out/string_shooter_real.gif" -q
 ropesim frames "$runs/string_shooter_real" --times 0,0.03,0.06,0.1,0.2,0.5,1,3 --columns 4 --width 760 \
     -o "$out/string_shooter_real_frames.png" -q
+
+# the mooring chain: one wave period overlaid, two periods animated at twice the speed, and its tensions
+ropesim run mooring_chain -o "$runs/mooring_chain" -q
+ropesim frames "$runs/mooring_chain" --overlay --times 60,62,64,66,68 --width 760 -o "$out/mooring_chain.png" -q
+ropesim animate "$runs/mooring_chain" --start 50 --end 70 --speed 2 --fps 10 --size 480 \
+    -o "$out/mooring_chain.gif" -q
+ropesim plot "$runs/mooring_chain" -o "$out/mooring_chain_plot.png" -q
+# the float drawn down as the current comes in, and the beam's first half swing
+ropesim run buoy_tether -o "$runs/buoy_tether" -q
+ropesim frames "$runs/buoy_tether" --overlay --times 0,30,45,60,75,90,120,360 --width 480 \
+    -o "$out/buoy_tether.png" -q
+ropesim plot "$runs/buoy_tether" -o "$out/buoy_tether_plot.png" -q
+ropesim run cantilever_beam -o "$runs/cantilever_beam" -q
+ropesim frames "$runs/cantilever_beam" --overlay --times 0,0.1,0.2,0.3,0.44 --width 760 \
+    -o "$out/cantilever_beam.png" -q
+ropesim plot "$runs/cantilever_beam" -o "$out/cantilever_beam_plot.png" -q
 du -ch "$out"/* | tail -1

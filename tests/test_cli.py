@@ -106,11 +106,25 @@ def test_trajectory_covers_zero_to_t_end(runs, name):
     np.testing.assert_array_equal(x[0], model.x0.T)
     np.testing.assert_array_equal(v[0], model.v0.T)
     assert np.all(np.isfinite(x)) and np.all(np.isfinite(v))
-    for drive in scene.driven:  # driven nodes sit on x0 + V t at every saved frame
+    for drive in scene.driven:  # driven nodes sit on x0 + V t (+ their ramped sinusoid) at every saved frame
+        assert drive.path_table is None, "teach this test the path"
+        # the ramp r = 10 s^3 - 15 s^4 + 6 s^5, s = t / ramp_time (smootherstep), and its rate
+        s = np.minimum(t / drive.ramp_time, 1.0) if drive.ramp_time > 0 else np.ones_like(t)
+        ramp = s ** 3 * (10 - 15 * s + 6 * s ** 2)
+        dramp = 30 * s ** 2 * (1 - s) ** 2 / drive.ramp_time if drive.ramp_time > 0 else np.zeros_like(t)
+        wave, dwave = np.zeros((frames, d)), np.zeros((frames, d))
+        for axis in range(d) if drive.amplitude is not None else ():
+            a, phase = drive.amplitude[axis], math.radians(drive.phase[axis])
+            if a != 0.0:
+                omega = 2 * math.pi / drive.period[axis]
+                wave[:, axis] = a * (np.sin(omega * t + phase) - math.sin(phase))
+                dwave[:, axis] = a * omega * np.cos(omega * t + phase)
         for i in drive.nodes:
-            expected = model.x0[:, i] + np.outer(t, drive.velocity)
+            i = scene.node(i)
+            expected = model.x0[:, i] + np.outer(t, drive.velocity) + ramp[:, None] * wave
             np.testing.assert_allclose(x[:, i], expected, rtol=0, atol=1e-12)
-            np.testing.assert_allclose(v[:, i], np.broadcast_to(drive.velocity, (frames, d)), rtol=0, atol=1e-12)
+            speed = np.broadcast_to(drive.velocity, (frames, d)) + dramp[:, None] * wave + ramp[:, None] * dwave
+            np.testing.assert_allclose(v[:, i], speed, rtol=0, atol=1e-12)
 
 
 @pytest.mark.parametrize("name", SCENES)

@@ -716,3 +716,44 @@ def test_a_physical_rope_whose_per_node_values_would_overflow_is_refused(rope, k
     """The per-node values derived from the physical form obey the per-node keys' limits, so a resolved scene
     always loads again."""
     refused(variant(LINE, rope=rope), key, fragment)
+
+
+CHAIN_ON_A_SEABED = """
+dimension = 2
+[rope]
+length = 120.0
+segments = 24
+mass_per_length = 50.0
+diameter = 0.1
+EA = 1e8
+[initial]
+shape = "equilibrium"
+start = [0.0, -30.0]
+end = [100.0, 0.0]
+[pinned]
+nodes = [0, -1]
+[gravity]
+[seabed]
+height = -30.0
+[integrator]
+dt = 0.001
+t_end = 0.01
+"""
+
+
+def test_an_equilibrium_start_keeps_its_ends_where_the_scene_puts_them():
+    """The static solver's first guess, a sagging curve, is lifted onto the seabed where it would pass through
+    it, but its ends are held nodes and stay where the scene puts them; so the loader's check that no held node
+    starts below the seabed sees a buried anchor where it really is. (The guess used to lift a buried anchor
+    onto the seabed: the scene loaded with its anchor silently moved.)"""
+    from ropesim.scene.shapes import initial_positions
+
+    scene = scene_from_toml(CHAIN_ON_A_SEABED)
+    x = initial_positions(scene)
+    assert tuple(x[:, 0]) == (0.0, -30.0) and tuple(x[:, -1]) == (100.0, 0.0)
+    assert np.all(x[1] >= -30.0) and np.any(x[1, 1:-1] == -30.0)   # the sag lies on the seabed
+    model = build(scene)
+    assert tuple(model.x0[:, 0]) == (0.0, -30.0) and tuple(model.x0[:, -1]) == (100.0, 0.0)
+    buried = CHAIN_ON_A_SEABED.replace("start = [0.0, -30.0]", "start = [0.0, -30.5]")
+    with pytest.raises(SceneError, match=r"seabed.height: puts the seabed 0.5 m above held node 0 \(at y = -30.5 m\)"):
+        scene_from_toml(buried)

@@ -163,6 +163,36 @@ def test_outline_projects_the_thrower_box_and_guide_cylinders(runs):
     assert outline(model3, projection("xy", 3))[1:] == flat[1:]
 
 
+def test_a_seabed_is_drawn_edge_on_and_a_swaying_drive_quotes_no_speed(tmp_path):
+    """The mooring chain's picture: the seabed is the ground line y = height (+ tan(slope) x) with the ground
+    below it, in the side view only; it does not widen the view. Its fairlead surges and heaves, so the legend
+    says "driven node" without the constant velocity a tow would quote (the sinusoid's would be 0 m/s)."""
+    from ropesim.render.framing import Ground, outline_extent
+    from ropesim.render.scene_artist import special_nodes
+
+    scene = ropesim.load_scene(SCENARIOS / "mooring_chain.toml", ["integrator.t_end=0.2", "output.interval=0.1"])
+    model = SimpleNamespace(scene=scene)
+    assert outline(model, projection("xy", 2)) == [Ground(-50.0, 0.0)]
+    sloped = replace(scene, seabed=replace(scene.seabed, slope=10.0))
+    assert outline(SimpleNamespace(scene=sloped), projection("xy", 2)) == [Ground(-50.0, math.tan(math.radians(10)))]
+    scene3 = replace(scene, dimension=3)
+    assert outline(SimpleNamespace(scene=scene3), projection("zy", 3)) == [Ground(-50.0, 0.0)]
+    assert outline(SimpleNamespace(scene=scene3), projection("xz", 3)) == []
+    assert outline(SimpleNamespace(scene=replace(sloped, dimension=3)), projection("zy", 3)) == []
+    lo, hi = outline_extent([Ground(-50.0, 0.0)])
+    assert np.all(np.isinf(lo)) and np.all(np.isinf(hi))
+    assert [label for label, _, _ in special_nodes(build(scene))] == ["driven node"]
+    heli = ropesim.load_scene(SCENARIOS / "helicopter_mass.toml")
+    assert "driven node (8 m/s)" in [label for label, _, _ in special_nodes(build(heli))]
+    # drawn: below the seabed's line the picture is the ground's grey, above it the water's white
+    ropesim.simulate(scene, tmp_path / "chain")
+    frame_sheet(Trajectory.open(tmp_path / "chain"), tmp_path / "chain.png", count=1, width=480)
+    image = np.asarray(Image.open(tmp_path / "chain.png").convert("RGB")).astype(int)
+    grey = np.all(np.abs(image - 230) <= 2, axis=2)        # GEOMETRY's facecolor 0.9
+    rows = np.flatnonzero(grey.mean(axis=1) > 0.5)
+    assert len(rows) > 10 and image.shape[0] * 0.3 < rows.min() < image.shape[0] * 0.8
+
+
 @pytest.mark.parametrize("name, follow", [("shooter", False), ("heli", False), ("heli", True), ("towed3d", True)])
 def test_view_box_holds_every_node_of_the_whole_run_read_in_blocks(runs, monkeypatch, name, follow):
     traj = runs[name]

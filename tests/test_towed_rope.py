@@ -163,3 +163,19 @@ def test_discrete_chain_approaches_the_continuous_bessel_modes():
         errors.append(abs(omegas[0] / bessel[0] - 1))
     assert errors[0] < 0.02
     assert errors[1] < errors[0] * 0.6 and errors[2] < errors[1] * 0.6
+
+
+def test_a_rope_with_bending_stiffness_is_no_towed_rope(scenarios):
+    """The towed rope's steady state balances weight and drag alone: a rope with EI (a cantilever holds a shape
+    of its own) gets no towed-rope figures in its summary or plot, as a rope with [bending] gets none."""
+    from ropesim.analysis.towed import towed_end
+
+    assert towed_end(ropesim.load_scene(scenarios / "helicopter_mass.toml")) == 0
+    assert towed_end(ropesim.load_scene(scenarios / "helicopter_mass.toml", ["rope.EI=10.0"])) is None
+    cantilever = ropesim.scene_from_toml(
+        'dimension = 2\n[rope]\nlength = 2.0\nsegments = 4\nmass_per_length = 1.0\nEA = 1e4\nEI = 5.0\n'
+        '[initial]\nshape = "line"\nstart = [0.0, 0.0]\nend = [2.0, 0.0]\n[pinned]\nnodes = [0]\nclamped = [0]\n'
+        '[gravity]\n[integrator]\ndt = 0.001\nt_end = 0.01\n')
+    assert towed_end(cantilever) is None
+    summary = ropesim.simulate(cantilever).summary
+    assert "towed" not in summary

@@ -21,8 +21,9 @@ STRAIGHT_TOLERANCE_DEG = 1.0
 def towed_end(scene: Scene) -> int | None:
     """The held end of a towed rope (0 or N-1), or None if the scene is not one.
 
-    A towed rope is an open line with exactly one held node, at one of its ends, and no bending, thrower,
-    guides, seabed, moving drive or fluid terms but the linear [drag] (so the steady state above is exact).
+    A towed rope is an open line with exactly one held node, at one of its ends, and no bending (neither
+    [bending] nor rope.EI), thrower, guides, seabed, moving drive or fluid terms but the linear [drag] (so the
+    steady state above is exact).
     """
     n = scene.rope.nodes
     held = [scene.node(i) for i in (scene.pinned.nodes if scene.pinned else ())]
@@ -32,6 +33,8 @@ def towed_end(scene: Scene) -> int | None:
         return None
     if scene.bending is not None or scene.thrower is not None or scene.guides or scene.seabed is not None:
         return None
+    if scene.rope.EI is not None:
+        return None   # a bending rope (a cantilever) holds a shape the steady state above knows nothing of
     if any(drive.moving for drive in scene.driven):
         return None   # the steady state needs a constant tow velocity
     if any(getattr(scene, part) is not None for part in ("flow", "fluid_drag", "viscous_drag", "buoyancy",

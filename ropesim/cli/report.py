@@ -139,6 +139,8 @@ def print_check(scene: Scene, source: Path) -> None:
               else f"velocity {list(init.velocity)} m/s")
     table.add_row("initial", f"{init.shape}, {moving}")
     terms = ["springs"]
+    if rope.EI:
+        terms.append(f"bending stiffness (EI = {rope.EI:g} N m^2)")
     if scene.bending:
         terms.append(f"bending (k2 = {scene.bending.stiffness:g} N/m)")
     if scene.gravity:
@@ -168,12 +170,15 @@ def print_check(scene: Scene, source: Path) -> None:
         terms.append(f"added mass (Ca_n = {scene.added_mass.ca_normal:g}, Ca_t = {scene.added_mass.ca_tangential:g})")
     if scene.bodies:
         terms.append(f"{len(scene.bodies)} bod{'ies' if len(scene.bodies) > 1 else 'y'}")
+    if scene.seabed:
+        terms.append(_seabed_text(scene.seabed))
     table.add_row("force terms", ", ".join(terms))
     held = []
     if scene.pinned:
-        held.append(f"pinned {list(scene.pinned.nodes)}")
+        clamped = f" (clamped {list(scene.pinned.clamped)})" if scene.pinned.clamped else ""
+        held.append(f"pinned {list(scene.pinned.nodes)}{clamped}")
     for d in scene.driven:
-        held.append(f"driven {list(d.nodes)} at {list(d.velocity)} m/s")
+        held.append(f"driven {list(d.nodes)} " + _motion_text(d))
     if held:
         table.add_row("held nodes", "; ".join(held))
     for o in scene.overrides:
@@ -185,6 +190,30 @@ def print_check(scene: Scene, source: Path) -> None:
     for key, value in stability_rows(model, scene.integrator.method, grid.dt):
         table.add_row(key, value)
     _console().print(table)
+
+
+def _seabed_text(bed) -> str:
+    """The seabed in one phrase: where it is, its contact stiffness and damping, its friction."""
+    slope = f" + tan({bed.slope:g} deg) x" if bed.slope else ""
+    if bed.friction_axial is None or bed.friction_axial == bed.friction:
+        friction = f", friction {bed.friction:g}" if bed.friction else ""
+    else:
+        friction = f", friction {bed.friction:g} across, {bed.friction_axial:g} along"
+    return (f"seabed (y = {bed.height:g} m{slope}, kBot = {bed.stiffness:g} N/m^3, cBot = {bed.damping:g} "
+            f"N s/m^3{friction})")
+
+
+def _motion_text(drive) -> str:
+    """How a driven node moves: its constant velocity, and its sinusoid and path, ramped in."""
+    parts = [f"at {list(drive.velocity)} m/s"] if any(drive.velocity) or not drive.moving else []
+    if drive.amplitude is not None:
+        axes = [f"{'xyz'[k]} {a:g} m, {drive.period[k]:g} s" + (f", {drive.phase[k]:g} deg" if drive.phase[k] else "")
+                for k, a in enumerate(drive.amplitude) if a]
+        parts.append("sinusoid " + "; ".join(axes))
+    if drive.path_table is not None:
+        parts.append(f"a path of {len(drive.path_table)} rows")
+    ramp = f", ramped in over {drive.ramp_time:g} s" if drive.moving and drive.ramp_time else ""
+    return " + ".join(parts) + ramp
 
 
 def stability_rows(model, method: str, dt: float) -> list[tuple[str, str]]:

@@ -104,16 +104,28 @@ class Band:
     one_sided: bool = False
 
 
+@dataclass(frozen=True)
+class Ground:
+    """A seabed seen edge-on: the line v = height + slope u across the picture, the ground below it."""
+
+    height: float
+    slope: float
+
+
 def outline(model: Model, proj: Projection) -> list:
-    """The scene's fixed geometry projected on ``proj``: the thrower box, then the guide circles.
+    """The scene's fixed geometry projected on ``proj``: the seabed, the thrower box, then the guide circles.
 
     The box is |x - cx| < L/2, |y - cy| < W/2 (and |z - cz| < W/2), turned by its launch angle in x-y: drawn
     turned in the x-y view, and as the extent of the turned box in a view along x or y; a guide is a circle in
-    x-y, a cylinder along z in 3-D.
+    x-y, a cylinder along z in 3-D. The seabed, the plane y = height + tan(slope) x, is drawn edge-on in the
+    side view (x across, y up), and in the front view (z across) when it is flat; not from above.
     """
     scene = model.scene
     a, b = proj.axes
     shapes: list = []
+    bed = scene.seabed
+    if bed is not None and b == 1 and (a == 0 or bed.slope == 0.0):
+        shapes.append(Ground(bed.height, math.tan(math.radians(bed.slope)) if a == 0 else 0.0))
     if scene.thrower is not None:
         t = scene.thrower
         if t.angle == 0.0:
@@ -145,6 +157,8 @@ def outline_extent(shapes: list) -> tuple[np.ndarray, np.ndarray]:
         elif isinstance(s, Circle):
             c = np.asarray(s.center)
             lo, hi = np.minimum(lo, c - s.radius), np.maximum(hi, c + s.radius)
+        elif isinstance(s, Ground):
+            continue   # unbounded: the rope on it sets the view
         else:
             lo[s.axis] = min(lo[s.axis], s.center - s.half)
             hi[s.axis] = max(hi[s.axis], s.center + s.half)

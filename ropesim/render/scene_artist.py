@@ -1,6 +1,6 @@
 """The scene drawn on a matplotlib Axes: its fixed geometry once, the rope's moving parts per frame.
 
-Fixed: the thrower box, the guide circles (dashed when one-sided), the pinned nodes. Moving: the rope (a line
+Fixed: the seabed, the thrower box, the guide circles (dashed when one-sided), the pinned nodes. Moving: the rope (a line
 through its nodes, closed for a loop), the driven nodes, heavier nodes (the end mass, drawn larger as the
 square root of its mass ratio) and nodes with extra drag (the parachute, a canopy). Every artist is drawn
 through its own translation, so a view that follows the driven node moves them all without re-laying the
@@ -13,11 +13,11 @@ import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.path import Path
 from matplotlib.patches import Circle as CirclePatch
-from matplotlib.patches import Rectangle
+from matplotlib.patches import Polygon, Rectangle
 from matplotlib.transforms import Affine2D
 
 from ..model.build import Model
-from .framing import BAND_REACH, Band, Box, Circle, Projection, outline
+from .framing import BAND_REACH, Band, Box, Circle, Ground, Projection, outline
 
 ROPE_COLOR = "#1f77b4"
 NODE_SIZE = 2.6          # [pt] marker of an ordinary node
@@ -48,6 +48,8 @@ class Geometry:
                 patch = CirclePatch(shape.center, shape.radius, fill=False, zorder=2,
                                     linestyle="--" if shape.one_sided else "-",
                                     edgecolor=GEOMETRY["edgecolor"], linewidth=1.2)
+            elif isinstance(shape, Ground):
+                patch = _ground(shape)
             else:
                 patch = _band(shape)
             self.artists.append(ax.add_patch(patch))
@@ -72,6 +74,14 @@ def _band(shape: Band) -> Rectangle:
     else:
         xy, w, h = (-BAND_REACH, lo), 2 * BAND_REACH, 2 * shape.half
     return Rectangle(xy, w, h, zorder=1, linestyle="--" if shape.one_sided else "-", **GEOMETRY)
+
+
+def _ground(shape: Ground) -> Polygon:
+    """The seabed's line across the whole picture and the ground below it."""
+    u = np.array([-BAND_REACH, BAND_REACH])
+    v = shape.height + shape.slope * u
+    return Polygon([(u[0], v[0]), (u[1], v[1]), (u[1], v[1] - BAND_REACH), (u[0], v[0] - BAND_REACH)],
+                   closed=True, zorder=1, **GEOMETRY)
 
 
 def pinned_style() -> dict:
@@ -114,8 +124,11 @@ def special_nodes(model: Model) -> list[tuple[str, np.ndarray, dict]]:
             out.append((f"drag body, CdA {body.cd_area:g} m^2", np.array([i]), parachute_style()))
     driven = sorted({scene.node(i) for d in scene.driven for i in d.nodes})
     if driven:
-        speeds = ", ".join(f"{np.linalg.norm(d.velocity):g}" for d in scene.driven)
-        out.append((f"driven node ({speeds} m/s)", np.array(driven), driven_style()))
+        if any(d.moving for d in scene.driven):   # a sinusoid or a path: no one speed to quote
+            out.append(("driven node", np.array(driven), driven_style()))
+        else:
+            speeds = ", ".join(f"{np.linalg.norm(d.velocity):g}" for d in scene.driven)
+            out.append((f"driven node ({speeds} m/s)", np.array(driven), driven_style()))
     return out
 
 

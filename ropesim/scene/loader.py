@@ -311,7 +311,7 @@ def _check_seabed(scene: S.Scene, fail) -> None:
                                      "it, or rope.diameter")
     from .shapes import initial_positions
 
-    x = initial_positions(replace(scene, seabed=None))   # where the scene puts them (a sagging guess is lifted)
+    x = initial_positions(scene)   # the held nodes where the scene puts them (the sagging guess keeps its ends)
     slope = math.radians(bed.slope)
     below = (bed.height + math.tan(slope) * x[0] - x[1]) * math.cos(slope)
     held = set(scene.pinned.nodes if scene.pinned else ()) | {i for d in scene.driven for i in d.nodes}

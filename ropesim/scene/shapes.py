@@ -74,6 +74,7 @@ def sagging_line(start: np.ndarray, end: np.ndarray, n: int, length: float, seab
     if seabed is not None:   # not through the seabed: lift what sinks below it onto it
         slope = np.tan(np.radians(seabed.slope))
         path[1] = np.maximum(path[1], seabed.height + slope * path[0])
+        path[:, 0], path[:, -1] = start, end   # the ends stay where the scene puts them (an anchor may be buried)
     along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=1), axis=0))])
     where = np.linspace(0.0, along[-1], n)
     return np.stack([np.interp(where, along, path[d]) for d in range(dim)])
