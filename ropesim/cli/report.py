@@ -138,6 +138,29 @@ def print_check(scene: Scene, source: Path) -> None:
     moving = ("a velocity per node" if getattr(init, "velocities", None) is not None
               else f"velocity {list(init.velocity)} m/s")
     table.add_row("initial", f"{init.shape}, {moving}")
+    table.add_row("force terms", ", ".join(force_terms(scene, model)))
+    held = []
+    if scene.pinned:
+        clamped = f" (clamped {list(scene.pinned.clamped)})" if scene.pinned.clamped else ""
+        held.append(f"pinned {list(scene.pinned.nodes)}{clamped}")
+    for d in scene.driven:
+        held.append(f"driven {list(d.nodes)} " + _motion_text(d))
+    if held:
+        table.add_row("held nodes", "; ".join(held))
+    for o in scene.overrides:
+        parts = [f"mass {o.mass:g} kg" if o.mass is not None else "", f"drag {o.drag:g} kg/s" if o.drag is not None
+                 else ""]
+        table.add_row(f"node {o.index}", ", ".join(p for p in parts if p))
+    table.add_row("time", f"{scene.integrator.method}, dt = {grid.dt:.6g} s, t_end = {scene.integrator.t_end:g} s "
+                          f"({grid.steps} steps, {grid.frames} frames)")
+    for key, value in stability_rows(model, scene.integrator.method, grid.dt):
+        table.add_row(key, value)
+    _console().print(table)
+
+
+def force_terms(scene: Scene, model) -> list[str]:
+    """Each force term the scene switches on, in a short phrase with its main parameters."""
+    rope = scene.rope
     terms = ["springs"]
     if rope.EI:
         terms.append(f"bending stiffness (EI = {rope.EI:g} N m^2)")
@@ -172,24 +195,7 @@ def print_check(scene: Scene, source: Path) -> None:
         terms.append(f"{len(scene.bodies)} bod{'ies' if len(scene.bodies) > 1 else 'y'}")
     if scene.seabed:
         terms.append(_seabed_text(scene.seabed))
-    table.add_row("force terms", ", ".join(terms))
-    held = []
-    if scene.pinned:
-        clamped = f" (clamped {list(scene.pinned.clamped)})" if scene.pinned.clamped else ""
-        held.append(f"pinned {list(scene.pinned.nodes)}{clamped}")
-    for d in scene.driven:
-        held.append(f"driven {list(d.nodes)} " + _motion_text(d))
-    if held:
-        table.add_row("held nodes", "; ".join(held))
-    for o in scene.overrides:
-        parts = [f"mass {o.mass:g} kg" if o.mass is not None else "", f"drag {o.drag:g} kg/s" if o.drag is not None
-                 else ""]
-        table.add_row(f"node {o.index}", ", ".join(p for p in parts if p))
-    table.add_row("time", f"{scene.integrator.method}, dt = {grid.dt:.6g} s, t_end = {scene.integrator.t_end:g} s "
-                          f"({grid.steps} steps, {grid.frames} frames)")
-    for key, value in stability_rows(model, scene.integrator.method, grid.dt):
-        table.add_row(key, value)
-    _console().print(table)
+    return terms
 
 
 def _seabed_text(bed) -> str:
