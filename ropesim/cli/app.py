@@ -82,6 +82,13 @@ SetOpt = Annotated[Optional[list[str]], typer.Option(
          "E.g. --set integrator.dt=0.002 --set rope.nodes=61 --set overrides.0.mass=50.")]
 
 
+def _compiling(enabled: bool = True):
+    """On a terminal, a spinner while Numba compiles, saying what compiles (see :mod:`ropesim.cli.status`)."""
+    from .status import Startup
+
+    return Startup(enabled and sys.stderr.isatty()).watch()
+
+
 def fail(message: str, code: int = EXIT_BAD_INPUT) -> None:
     """Print one line to stderr and exit with ``code``."""
     typer.echo(f"ropesim: {message}", err=True)
@@ -151,38 +158,20 @@ def run(
     Frames stream to the folder in checkpoints; Ctrl-C, SIGTERM or SIGHUP stop the run at its next chunk and
     keep them, and `ropesim run --resume RUN_DIR` continues it.
     """
-    from .report import print_summary
-    from ..io.runfolder import DiskFull, RunFolderError
-    from ..run import BLEW_UP, INTERRUPTED, simulate
-
     progress = not quiet and sys.stderr.isatty()
-    if resume is not None:
-        if scene_file is not None or out is not None:
-            fail("--resume RUN_DIR continues the run in RUN_DIR: give no SCENE and no --out with it")
-        folder, where = resume, str(resume)
-        t_end = _resume_t_end(sets)
-        run_it = (lambda: _resume(folder, t_end, progress))
-    else:
-        if scene_file is None:
-            fail("missing SCENE: a scene file or a built-in scene's name (or --resume RUN_DIR)")
-        scene, where = _load(scene_file, sets)
-        _check_time_step(scene, where, force, quiet)
-        folder = out if out is not None else Path("runs") / scene.name
-        if folder.exists() and not folder.is_dir():
-            fail(f"--out {folder}: exists and is not a folder")
-        blocked = next((p for p in folder.parents if p.exists() and not p.is_dir()), None)
-        if blocked is not None:
-            fail(f"--out {folder}: cannot write the run folder: {blocked} is a file, not a folder")
-        _check_size(scene, where, folder, force, quiet)
-        run_it = (lambda: simulate(scene, folder, progress=progress))
-    try:
-        traj = run_it()
-    except DiskFull as exc:
-        fail(str(exc), EXIT_WRITE)
-    except RunFolderError as exc:
-        fail(str(exc))
-    except OSError as exc:
-        fail(f"{folder}: cannot write the run folder ({exc.strerror or exc})", EXIT_WRITE)
+    from .status import Startup, take_early
+
+    # On a terminal a spinner shows at once (before numpy and Numba load; from main() on, before Typer parsed
+    # the command line) and says what compiles, if anything.
+    status = take_early() or Startup(progress)
+    if not progress:
+        status.close()
+    status.update(f"Preparing {scene_file if resume is None else resume}")
+    with status:
+        traj, folder, where = _run_command(scene_file, out, sets, resume, quiet, force, progress, status)
+    from .report import print_summary
+    from ..run import BLEW_UP, INTERRUPTED
+
     summary = traj.summary
     if not quiet:
         print_summary(summary, folder)
@@ -195,6 +184,46 @@ def run(
              exit_code(name=by))
     if animate_:
         _animate(folder, None, quiet, fps=fps)
+
+
+def _run_command(scene_file, out, sets, resume, quiet, force, progress, status):
+    """`ropesim run`'s work up to the finished run: (trajectory, run folder, how to name it in messages)."""
+    from ..io.runfolder import DiskFull, RunFolderError
+    from ..run import simulate
+
+    if resume is not None:
+        if scene_file is not None or out is not None:
+            fail("--resume RUN_DIR continues the run in RUN_DIR: give no SCENE and no --out with it")
+        folder, where = resume, str(resume)
+        t_end = _resume_t_end(sets)
+        status.update(f"Resuming {folder}")
+        status.watch()
+        run_it = (lambda: _resume(folder, t_end, progress, status.stop))
+    else:
+        if scene_file is None:
+            fail("missing SCENE: a scene file or a built-in scene's name (or --resume RUN_DIR)")
+        scene, where = _load(scene_file, sets)
+        status.update(f"Preparing {scene.name}", kernel=f"the {scene.integrator.method} kernel")
+        status.watch()   # imports Numba, which the checks below need anyway
+        _check_time_step(scene, where, force, quiet)
+        folder = out if out is not None else Path("runs") / scene.name
+        if folder.exists() and not folder.is_dir():
+            fail(f"--out {folder}: exists and is not a folder")
+        blocked = next((p for p in folder.parents if p.exists() and not p.is_dir()), None)
+        if blocked is not None:
+            fail(f"--out {folder}: cannot write the run folder: {blocked} is a file, not a folder")
+        _check_size(scene, where, folder, force, quiet)
+        status.update(f"Running {scene.name}")
+        run_it = (lambda: simulate(scene, folder, progress=progress, before_bar=status.stop))
+    try:
+        traj = run_it()
+    except DiskFull as exc:
+        fail(str(exc), EXIT_WRITE)
+    except RunFolderError as exc:
+        fail(str(exc))
+    except OSError as exc:
+        fail(f"{folder}: cannot write the run folder ({exc.strerror or exc})", EXIT_WRITE)
+    return traj, folder, where
 
 
 def _resume_t_end(sets: list[str] | None) -> float | None:
@@ -214,10 +243,10 @@ def _resume_t_end(sets: list[str] | None) -> float | None:
     return t_end
 
 
-def _resume(folder: Path, t_end: float | None, progress: bool):
+def _resume(folder: Path, t_end: float | None, progress: bool, before_bar=None):
     from ..run import resume
 
-    return resume(folder, t_end, progress=progress)
+    return resume(folder, t_end, progress=progress, before_bar=before_bar)
 
 
 def _check_size(scene, where: str, folder: Path, force: bool, quiet: bool) -> None:
@@ -365,8 +394,9 @@ def sweep(
     from ..sweep.plan import SweepError
 
     try:
-        result = run_sweep(_source(scene_file).path, sets or [], out=out, jobs=jobs, scheduler=scheduler,
-                           plots=plots or [], quiet=quiet)
+        with _compiling(not quiet):
+            result = run_sweep(_source(scene_file).path, sets or [], out=out, jobs=jobs, scheduler=scheduler,
+                               plots=plots or [], quiet=quiet)
     except SweepError as exc:
         fail(str(exc))
     if not quiet:
@@ -673,7 +703,8 @@ def accuracy(
     steps["pefrl"] = steps.get("pefrl", 0) + 1.5 * t_end / (min(rungs) / 16)     # the reference
     _warn_ladder(scene, steps, "accuracy")
     try:
-        report = accuracy_report(scene, names, ladder, repeats)
+        with _compiling():
+            report = accuracy_report(scene, names, ladder, repeats)
     except (KeyboardInterrupt, Stopped) as exc:
         fail("accuracy interrupted; nothing written", exit_code(exc))
     try:
@@ -716,7 +747,8 @@ def stability(
     probes = (len(ladder or range(20)) + 20) * len(ks or [0])       # the ladder and about 20 bisection probes
     _warn_ladder(scene, {m: probes * steps for m in (names or METHOD_NAMES)}, "stability")
     try:
-        result = stability_sweep(scene, names, ladder, ks, steps)
+        with _compiling():
+            result = stability_sweep(scene, names, ladder, ks, steps)
     except (KeyboardInterrupt, Stopped) as exc:
         fail("stability interrupted; nothing written", exit_code(exc))
     try:
@@ -741,12 +773,18 @@ def main() -> None:
     for name in ("SIGTERM", "SIGHUP"):
         if hasattr(signal, name):
             signal.signal(getattr(signal, name), _raise_stopped)
+    from .status import close_early, start_early
+
+    start_early(sys.argv[1:])   # `ropesim run` on a terminal: its spinner, before Typer parses (0.15 s)
     try:
         app()
     except (KeyboardInterrupt, Stopped) as exc:
+        close_early()
         name = exc.name if isinstance(exc, Stopped) else "SIGINT"
         typer.echo(f"ropesim: {'interrupted' if name == 'SIGINT' else f'stopped by {name}'}", err=True)
         sys.exit(exit_code(exc))
+    finally:
+        close_early()   # Typer refused the command line before `run` took the spinner
 
 
 if __name__ == "__main__":  # pragma: no cover
