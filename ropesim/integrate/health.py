@@ -117,8 +117,10 @@ def verdict(energy, stretch, node, x, v, ledger, limits):
 @njit(cache=True, error_model="numpy")
 def save_frame(frame, t, x, v, ledger, frames_t, frames_x, frames_v, frames_w):
     frames_t[frame] = t
-    frames_x[frame] = x
-    frames_v[frame] = v
+    for d in range(x.shape[0]):   # element by element: an array assignment compiles Numba's shape-mismatch
+        for i in range(x.shape[1]):   # message, seconds of a first run's compile
+            frames_x[frame, d, i] = x[d, i]
+            frames_v[frame, d, i] = v[d, i]
     for c in range(frames_w.shape[1]):
         frames_w[frame, c] = ledger[c]
 

@@ -151,7 +151,9 @@ def factor(band, corner, cyclic, p, wood):
             wmat[a, a] = 1.0
             for b in range(m):
                 wmat[nt - m + a, b] = -g[b, a]
-        zmat[:] = wmat
+        for r in range(wmat.shape[0]):   # element by element: an array assignment compiles Numba's
+            for b in range(wmat.shape[1]):   # shape-mismatch message, seconds of a first run's compile
+                zmat[r, b] = wmat[r, b]
         band_solve_columns(band, p, zmat)
         for b in range(m):
             for a in range(m):
