@@ -140,7 +140,7 @@ class Startup:
 
             streams = (sys.stdout, sys.stderr)
             console = Console(file=streams[1])
-            if not console.is_terminal:
+            if not console.is_terminal or console.is_dumb_terminal:   # TERM=dumb cannot redraw a line
                 self.enabled = False
                 return
             # rich's own redirection of stdout and stderr misses what Typer and click print (click keeps its own
