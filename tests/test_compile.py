@@ -2,7 +2,9 @@
 
 Whether a run compiled is observed, not inferred from its timing: Numba broadcasts a ``numba:compile`` event
 whenever a function compiles (a cache miss) and none when it loads one from its cache, and the probe below
-counts them while it runs every built-in scene, and every method on one scene, through the command line.
+counts them while it runs every built-in scene (whichever there are), every method on one scene and on a mooring
+line that starts in its static shape, and the static solver of `ropesim equilibrium` on each, through the command
+line.
 """
 
 from __future__ import annotations
@@ -19,8 +21,43 @@ from typer.testing import CliRunner
 
 from ropesim.cli.app import app
 from ropesim.integrate.methods import METHODS
+from ropesim.scene.builtin import builtin_names
 
 ROOT = Path(__file__).resolve().parent.parent
+
+# A scene no built-in one is yet: a line that starts in its static shape (the static solver before the run) on a
+# seabed, in water, its fairlead driven on a sinusoid.
+MOORING = """
+name = "mooring"
+[rope]
+length = 30.0
+segments = 12
+mass_per_length = 50.0
+diameter = 0.1
+EA = 1.0e6
+[initial]
+shape = "equilibrium"
+start = [0.0, 0.0]
+end = [24.0, 12.0]
+[pinned]
+nodes = [0]
+[[driven]]
+nodes = [-1]
+amplitude = [2.0, 1.0]
+period = [8.0, 8.0]
+[gravity]
+g = 9.81
+[fluid]
+density = 1025.0
+[buoyancy]
+[seabed]
+height = 0.0
+friction = 0.5
+[integrator]
+method = "sdirk2"
+dt = 0.0005
+t_end = 1.0
+"""
 
 PROBE = textwrap.dedent("""
     import json, sys, tempfile
@@ -45,17 +82,27 @@ PROBE = textwrap.dedent("""
     cases = [(name, []) for name in builtin_names()]
     cases += [("helicopter_mass", [f"integrator.method={m}"]) for m in METHODS]
     out = {}
-    for name, sets in cases:
-        before = len(compiled)
-        with tempfile.TemporaryDirectory() as tmp:
-            args = ["run", name, "--out", f"{tmp}/run", "--quiet", "--set", "integrator.t_end=0.02"]
+    with tempfile.TemporaryDirectory() as tmp:
+        mooring = f"{tmp}/mooring.toml"
+        open(mooring, "w").write(MOORING)
+        cases += [(mooring, [f"integrator.method={m}"]) for m in METHODS]
+        for name, sets in cases:
+            before = len(compiled)
+            args = ["run", name, "--out", f"{tmp}/run", "--quiet", "--force", "--set", "integrator.t_end=0.02"]
             for item in sets:
                 args += ["--set", item]
             result = CliRunner().invoke(app, args)
             summary = json.load(open(f"{tmp}/run/summary.json"))
-        out[" ".join([name, *sets])] = [result.exit_code, compiled[before:], summary["compile_time_s"]]
+            case = " ".join(["mooring" if name == mooring else name, *sets])
+            out[case] = [result.exit_code, compiled[before:], summary["compile_time_s"]]
+        for name in [*builtin_names(), mooring]:
+            before = len(compiled)
+            result = CliRunner().invoke(app, ["equilibrium", name])
+            case = "equilibrium " + ("mooring" if name == mooring else name)
+            solved = result.exception is None or isinstance(result.exception, SystemExit)   # exit 1: no static shape
+            out[case] = [0 if solved else repr(result.exception), compiled[before:], 0.0]
     print(json.dumps(out))
-""")
+""").replace("MOORING", repr(MOORING))
 
 
 def _run(args: list[str], cache: str) -> subprocess.CompletedProcess:
@@ -72,7 +119,8 @@ def _compile_then_probe(cache: str) -> tuple[str, dict]:
 
 
 def _check_nothing_compiles(runs: dict) -> None:
-    assert len(runs) == 9 + len(METHODS)
+    scenes = builtin_names()
+    assert len(runs) == len(scenes) + 2 * len(METHODS) + len(scenes) + 1   # the runs, then the static solves
     for case, (code, compiled, compile_time) in runs.items():
         assert code == 0, case
         assert compiled == [], f"{case} compiled {compiled}"
@@ -89,7 +137,7 @@ def test_after_ropesim_compile_no_run_compiles_anything():
     for name in [*METHODS, "static solver"]:
         assert any(line.split()[:1] == [name.split()[0]] for line in table.splitlines()), (name, table)
     assert "shares the loop of symplectic_euler" in table   # the splitting methods share one loop
-    assert "made ready for 9 built-in scenes" in table
+    assert f"made ready for {len(builtin_names())} built-in scenes" in table
     _check_nothing_compiles(runs)
 
 
