@@ -386,7 +386,8 @@ def equilibrium(
             fail(f"--out {out}: must name a .toml file")
         if out.exists() and not force:
             fail(f"--out {out}: exists; choose another file or add --force to replace it")
-    shape = solve(scene)
+    with _compiling():   # the static solver compiles on its first use
+        shape = solve(scene)
     print_equilibrium(shape, where)
     if not shape.converged:
         fail(f"{where}: the static solve did not converge (largest residual force {shape.residual:.3g} N after "
