@@ -153,24 +153,6 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
                       signal=flag.signal if status == INTERRUPTED and flag.is_set() else "", integrator=integrator)
 
 
-def advance_in_chunks(integrator: Integrator, steps: int, target_chunk_seconds: float = 0.1):
-    """``integrator.advance(steps)`` cut into chunks of about ``target_chunk_seconds`` (the numbers are the
-    same however it is cut), so that Ctrl-C or SIGTERM are honoured within a chunk instead of after the whole
-    run. Returns the last chunk's Advance with ``done`` summed; stops at the first bad status."""
-    done, chunk, result = 0, min(steps, 1000), None
-    while done < steps or result is None:
-        n = min(chunk, steps - done)
-        tick = time.perf_counter()
-        result = integrator.advance(n)
-        elapsed = time.perf_counter() - tick
-        done += result.done
-        if result.status != OK or n == 0:
-            break
-        if elapsed > 0:
-            chunk = max(1, int(result.done / elapsed * target_chunk_seconds))
-    return result._replace(done=done)
-
-
 def _sharp_contacts(scene: Scene) -> bool:
     """True when the scene has a thrower box or guide circles whose edges switch sharply."""
     return (scene.thrower is not None and scene.thrower.edge_width == 0) or any(g.edge_width == 0
@@ -335,7 +317,7 @@ def resume(folder: str | Path, t_end: float | None = None, progress: bool = Fals
                                  f"{on_grid}; run the scene again")
         if scene.integrator.t_end != old_t_end:
             new_text = scene_to_toml(scene)
-            from .io.trajectory import write_text_atomic
+            from .io.atomic import write_text_atomic
 
             write_text_atomic(folder / SCENE, new_text)
             m.update(_manifest_info(scene, grid), scene_sha256=scene_hash(new_text))

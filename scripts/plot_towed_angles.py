@@ -19,7 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from ropesim.model.build import build
-from ropesim.io.trajectory import RunFolderError, Trajectory
+from ropesim.io.runfolder import RunFolderError
+from ropesim.io.trajectory import Trajectory
 from ropesim.analysis.towed import exact_steady_state, segment_angles, towed_end
 
 WRITE_UP_T_END = 3.0  # s: the write-up's t_f for the helicopter

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import ropesim
+from ropesim.io import frames
 from ropesim.integrate.methods import METHODS
 from ropesim.model.build import build
 from ropesim.scene.loader import SceneError, load_scene
@@ -128,15 +129,15 @@ def test_a_blown_up_run_starts_from_its_last_finite_frame_and_a_non_finite_frame
         'shape = "line"\nstart = [0.0, 0.0]\nend = [1.1, 0.0]', 'shape = "from_run"\nrun = "wild"'))
     np.testing.assert_array_equal(build(load_scene(second)).x0.T, source.x[-1])
 
-    opened = ropesim.Trajectory.open
+    read = frames.read_run
 
     def poisoned(folder, verify=True):
-        traj = opened(folder, verify)
-        x = np.array(traj.x)
+        arrays, ledger, summary = read(folder, verify)
+        x = np.array(arrays["x"])
         x[-1, 3, 1] = np.nan
-        return ropesim.Trajectory(t=traj.t, x=x, v=traj.v, scene=traj.scene)
+        return {**arrays, "x": x}, ledger, summary
 
-    monkeypatch.setattr(ropesim.Trajectory, "open", staticmethod(poisoned))
+    monkeypatch.setattr(frames, "read_run", poisoned)
     err = _refusal(second)
     assert err.key == "initial.time" and "not finite (the run blew up)" in str(err)
 

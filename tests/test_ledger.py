@@ -12,7 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import ropesim
-from ropesim.analysis.ledger import LEDGER, ledger_series, read_flows
+from ropesim.analysis.ledger import LEDGER, ledger_series
+from ropesim.io.frames import read_flows
 from ropesim.model.build import build
 from ropesim.integrate.methods import METHODS
 from ropesim.integrate.splitting import kick_factors

@@ -97,7 +97,7 @@ def run_once(scene: Scene, method: str, dt: float, repeats: int = 1, exact_conta
     from ..integrate.health import net_flow
     from ..integrate.methods import make_integrator
     from ..model.energy import energy_terms
-    from ..run import advance_in_chunks
+    from ..integrate.base import advance_in_chunks
 
     scene = single_frame(scene, dt, method)
     model = build(scene)
@@ -178,7 +178,7 @@ def write_csv(report: Report, path) -> None:
     import csv
     import io
 
-    from ..io.trajectory import write_text_atomic
+    from ..io.atomic import write_text_atomic
 
     buf = io.StringIO()
     w = csv.writer(buf)

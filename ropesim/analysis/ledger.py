@@ -20,11 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.runfolder import LEDGER
 from ..model.build import Model
 from ..integrate.health import LEDGER_COLUMNS
 from ..model.energy import energy_terms
 
-LEDGER = "ledger.npz"
 FRAME_BLOCK = 256
 
 
@@ -42,21 +42,9 @@ def ledger_arrays(t: np.ndarray, flows: np.ndarray, energy0: float) -> dict[str,
 
 def write_ledger(folder: Path, t: np.ndarray, flows: np.ndarray, energy0: float) -> None:
     """Write ``ledger.npz`` atomically: the cumulative flows (F, C) at the saved frames' times."""
-    from ..io.trajectory import write_npz_atomic
+    from ..io.runfolder import write_npz_atomic
 
     write_npz_atomic(Path(folder) / LEDGER, ledger_arrays(t, flows, energy0))
-
-
-def read_flows(folder: Path) -> tuple[np.ndarray, float] | None:
-    """(flows (F, C), energy0) from a run folder's ``ledger.npz``, or None when it has none; a column an older
-    ropesim did not book is zero."""
-    path = Path(folder) / LEDGER
-    if not path.is_file():
-        return None
-    with np.load(path) as npz:
-        frames = len(npz["t"])
-        return (np.stack([npz[name] if name in npz.files else np.zeros(frames) for name in LEDGER_COLUMNS], axis=1),
-                float(npz["energy0"]))
 
 
 def ledger_series(model: Model, x: np.ndarray, v: np.ndarray, flows: np.ndarray, energy0: float) -> dict:

@@ -200,7 +200,7 @@ def probe(scene, method: str, dt: float, steps: int = PROBE_STEPS) -> bool:
     from ..integrate.methods import make_integrator
     from ..model.build import build
     from ..model.energy import energy_terms
-    from ..run import advance_in_chunks
+    from ..integrate.base import advance_in_chunks
 
     integ = dataclasses.replace(scene.integrator, method=method, dt=dt, t_end=steps * dt)
     out = dataclasses.replace(scene.output, interval=steps * dt)
@@ -296,7 +296,7 @@ def write_sweep(result: SweepResult, folder) -> tuple:
     import io
     from pathlib import Path
 
-    from ..io.trajectory import write_text_atomic
+    from ..io.atomic import write_text_atomic
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)

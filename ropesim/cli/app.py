@@ -377,7 +377,7 @@ def equilibrium(
     """
     from .report import print_equilibrium
     from ..analysis.statics import as_points_scene, equilibrium as solve
-    from ..io.trajectory import write_text_atomic
+    from ..io.atomic import write_text_atomic
     from ..scene.schema import scene_to_toml
 
     scene, where = _load(scene_file, sets)
@@ -425,7 +425,7 @@ def new(
     The copy keeps the original's comments, puts each key's meaning and unit above it, and lists the optional
     keys it leaves out, commented out at their defaults. Then: ropesim check NAME.toml; ropesim run NAME.toml.
     """
-    from ..io.trajectory import write_text_atomic
+    from ..io.atomic import write_text_atomic
     from ..scene.builtin import NAME, annotated_copy
 
     target = Path(name) if name.endswith(".toml") else Path(f"{name}.toml")
@@ -539,7 +539,8 @@ QuietOpt = Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but
 def _open_run(run_dir: Path, command: str):
     """The run folder ``run_dir``, opened lazily; a scene (a file, or a built-in's name) given where a run folder
     belongs is told apart from a missing folder, in one line that says what to run (exit 2)."""
-    from ..io.trajectory import TRAJECTORY, RunFolderError, Trajectory
+    from ..io.runfolder import TRAJECTORY, RunFolderError
+    from ..io.trajectory import Trajectory
     from ..scene.builtin import builtin_path, looks_like_a_name
 
     scene = run_dir if run_dir.is_file() else None
@@ -567,7 +568,7 @@ def _open_run(run_dir: Path, command: str):
 def _picture(make):
     """Call ``make()``; an unusable run folder or request, or an unwritable output, prints one line, exits 2."""
     from ..render import RenderError
-    from ..io.trajectory import RunFolderError
+    from ..io.runfolder import RunFolderError
 
     try:
         return make()

@@ -64,7 +64,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..model.motion import place_moving
-from .health import LEDGER_COLUMNS, initial_ledger, limits
+from .health import LEDGER_COLUMNS, OK, initial_ledger, limits
 
 CHECK_EVERY = 64   # steps between blow-up checks: a blow-up is caught within this many steps
 
@@ -251,3 +251,21 @@ class Integrator:
                                  f"{mine.shape} ({mine.dtype})")
             np.copyto(mine, theirs)
         self.step = int(state["step"])
+
+
+def advance_in_chunks(integrator: Integrator, steps: int, target_chunk_seconds: float = 0.1):
+    """``integrator.advance(steps)`` cut into chunks of about ``target_chunk_seconds`` (the numbers are the
+    same however it is cut), so that Ctrl-C or SIGTERM are honoured within a chunk instead of after the whole
+    run. Returns the last chunk's Advance with ``done`` summed; stops at the first bad status."""
+    done, chunk, result = 0, min(steps, 1000), None
+    while done < steps or result is None:
+        n = min(chunk, steps - done)
+        tick = time.perf_counter()
+        result = integrator.advance(n)
+        elapsed = time.perf_counter() - tick
+        done += result.done
+        if result.status != OK or n == 0:
+            break
+        if elapsed > 0:
+            chunk = max(1, int(result.done / elapsed * target_chunk_seconds))
+    return result._replace(done=done)

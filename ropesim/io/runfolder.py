@@ -46,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .atomic import FILE_MODE, _umask, atomic_output, fsync_path
+from .atomic import FILE_MODE, _umask, atomic_output, fsync_path, write_json_atomic
 
 FORMAT = "ropesim run folder 2"
 MANIFEST, LOCK, CHECKPOINT, STATE = "manifest.json", ".lock", "checkpoint", "state.npz"
@@ -680,8 +680,6 @@ class RunWriter:
                message: str = "") -> None:
         """A finished run: write ``files`` (name -> arrays, as npz), the final state and the summary, then commit
         the manifest with ``status``; the checkpoint streams go."""
-        from .trajectory import write_json_atomic
-
         try:
             for name, arrays in files.items():
                 write_npz_atomic(self.folder / name, arrays)
@@ -704,8 +702,6 @@ class RunWriter:
 
     def mark(self, status: str, message: str, summary: dict | None = None) -> None:
         """Record how an unfinished run stopped (interrupted) beside its last checkpoint; the summary first."""
-        from .trajectory import write_json_atomic
-
         if summary is not None:
             write_json_atomic(self.folder / SUMMARY, summary)
         self.manifest["status"], self.manifest["message"] = status, message

@@ -12,31 +12,16 @@ checking every frame's CRC-32 first.
 
 from __future__ import annotations
 
-import json
-import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .atomic import atomic_output
-
-from .runfolder import (CHECKPOINT, FINISHED, INCOMPLETE, INTERRUPTED, LEDGER, MANIFEST, SCENE, SUMMARY,  # noqa: F401
-                        TRAJECTORY, RunFolderError, holder, memmap_npz, open_stream_array, read_manifest,
-                        write_npz_atomic)
+from .frames import Moved, read_frames
+from .runfolder import SCENE, TRAJECTORY, RunFolderError, read_manifest
 
 ARRAYS = ("t", "x", "v")
 DERIVED = ("tension", "strain", "support")   # per frame, derived from t, x and v as they are stored
-
-
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` via a temporary file in the same folder, fsync and an atomic rename."""
-    with atomic_output(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
-
-
-def write_json_atomic(path: Path, data: dict) -> None:
-    write_text_atomic(path, json.dumps(data, indent=2, sort_keys=False) + "\n")
 
 
 class FrameStore:
@@ -142,9 +127,9 @@ class Trajectory:
             except SceneError as exc:
                 raise RunFolderError(f"{folder}: its scene.toml is not valid: {exc}") from None
             try:
-                arrays, ledger, summary = _read_frames(folder, manifest, verify)
+                arrays, ledger, summary = read_frames(folder, manifest, verify)
                 break
-            except _Moved:      # the run committed (or finished) while we read: read the new manifest
+            except Moved:       # the run committed (or finished) while we read: read the new manifest
                 if attempt == 2:
                     raise RunFolderError(f"{folder}: changes too fast to read (a run is finishing there)") from None
         missing = [a for a in ARRAYS if a not in arrays]
@@ -183,60 +168,3 @@ class Trajectory:
         return (f"Trajectory(scene={self.scene.name!r}, {self.summary.get('status', 'completed')}, "
                 f"{self.frames} frames, t = {float(self.t[0]):.6g} .. {float(self.t[-1]):.6g} s, "
                 f"{self.nodes} nodes, {self.x.shape[2]}-D, {'in memory' if self.folder is None else self.folder})")
-
-
-class _Moved(Exception):
-    """A checkpoint file vanished while reading: the run moved on; read its manifest again."""
-
-
-def _summary_file(folder: Path) -> dict:
-    try:
-        return json.loads((folder / SUMMARY).read_text(encoding="utf-8"))
-    except (ValueError, OSError):
-        return {}
-
-
-def _read_frames(folder: Path, manifest: dict | None, verify: bool):
-    """(named arrays, ledger (F, C) or None, summary) of a run folder, as its manifest says."""
-    if manifest is None or manifest["status"] in FINISHED:
-        if not (folder / TRAJECTORY).is_file():
-            raise RunFolderError(f"{folder}: not a run folder: {TRAJECTORY} is missing")
-        try:
-            arrays = memmap_npz(folder / TRAJECTORY, verify=verify)
-        except RunFolderError:
-            raise
-        except (zipfile.BadZipFile, ValueError, OSError, EOFError) as exc:
-            raise RunFolderError(f"{folder / TRAJECTORY}: corrupt or unreadable ({exc})") from None
-        return arrays, _read_ledger(folder), _summary_file(folder)
-    cp = manifest.get("checkpoint")
-    running = holder(folder)
-    if not cp or not cp.get("frames"):
-        what = f"is still starting (pid {running})" if running else "was stopped before its first checkpoint"
-        raise RunFolderError(f"{folder}: {what}: no frames yet")
-    arrays = {}
-    for name, spec in manifest["arrays"].items():
-        path = folder / CHECKPOINT / f"{name}.npy"
-        if not path.is_file():
-            raise _Moved()
-        arrays[name] = open_stream_array(path, tuple(spec["per_frame"]), np.dtype(spec["dtype"]), cp["frames"],
-                                         cp["crc32"].get(name), verify=verify)
-    ledger = arrays.pop("ledger", None)
-    summary = _summary_file(folder) if manifest["status"] == INTERRUPTED else {}
-    if summary.get("status") != manifest["status"]:
-        state = (f"still running ({running})" if running else
-                 "never finished (killed, or stopped by a full disk)")
-        summary = {"scene": manifest.get("scene", folder.name), "status": INCOMPLETE,
-                   "message": f"{state}; the last checkpoint is at t = {cp['t']:.6g} s ({cp['frames']} frames); "
-                              f"`ropesim run --resume {folder}` continues it",
-                   "t_end": cp["t"], "frames": cp["frames"], "steps": cp["step"]}
-    return arrays, ledger, summary
-
-
-def _read_ledger(folder: Path) -> np.ndarray | None:
-    from ..analysis.ledger import read_flows
-
-    try:
-        flows = read_flows(folder)
-    except (OSError, ValueError, KeyError, zipfile.BadZipFile, EOFError) as exc:
-        raise RunFolderError(f"{folder / LEDGER}: corrupt or unreadable ({exc})") from None
-    return None if flows is None else flows[0]

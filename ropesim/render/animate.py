@@ -10,12 +10,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Iterable, Iterator
+from typing import Callable, Iterable, Iterator, Protocol
 
 import numpy as np
 
 from ..model.build import Model, build
-from ..io.trajectory import Trajectory
+from ..scene.schema import Scene
 from . import RenderError
 from .encode import ANIMATION_TYPES, GIF_MAX_FPS, gif_fps, write_gif, write_mp4
 from .framing import Projection, figure_inches, followed_nodes, origin, projection, single_view, view_box
@@ -27,6 +27,15 @@ from .timeline import animation_plan
 
 DPI = 100
 PALETTE_SAMPLES = 5  # frames, evenly spread, whose colours make a GIF's palette
+
+
+class Frames(Protocol):
+    """What an animation needs of a run; a :class:`ropesim.Trajectory` is one (and this module need not import
+    it, which would close a circle: ``Trajectory.animate`` draws with this module)."""
+
+    scene: Scene
+    t: np.ndarray   # (F,) [s]
+    x: np.ndarray   # (F, N, D) [m]
 
 
 @dataclass(frozen=True)
@@ -42,7 +51,7 @@ class Animation:
 class FrameRenderer:
     """Renders saved frame i of a trajectory to an RGBA array (H, W, 4) uint8, redrawing only what moves."""
 
-    def __init__(self, traj: Trajectory, model: Model, proj: Projection, nodes: np.ndarray | None, size: int):
+    def __init__(self, traj: Frames, model: Model, proj: Projection, nodes: np.ndarray | None, size: int):
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
 
@@ -95,7 +104,7 @@ def picture_title(fig, model: Model, proj: Projection) -> None:
 
 
 @with_picture_text
-def animate(traj: Trajectory, out: str | Path, *, fps: float = 25.0, speed: float = 1.0,
+def animate(traj: Frames, out: str | Path, *, fps: float = 25.0, speed: float = 1.0,
             start: float | None = None, end: float | None = None, follow: bool = False, view: str | None = None,
             size: int = 640, progress: bool = False, note: Callable[[str], None] | None = None) -> Animation:
     """Write an animation of ``traj`` to ``out`` (.gif or .mp4) and say what was written.

@@ -71,7 +71,8 @@ def draw_energy(ax, traj: Trajectory, model: Model) -> None:
 
 def draw_ledger(ax, traj: Trajectory, model: Model) -> None:
     """The energy ledger: E(t) - E(0), the flows in and out, and the balance's residual (see analysis.ledger)."""
-    from ..analysis.ledger import ledger_series, ledger_summary, read_flows
+    from ..analysis.ledger import ledger_series, ledger_summary
+    from ..io.frames import read_flows
 
     stored = read_flows(traj.folder) if traj.folder is not None else None
     if stored is None:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
-from .loader import SceneError
+from .errors import SceneError
 
 SUFFIX = ".toml"
 

@@ -14,6 +14,8 @@ from pathlib import Path
 from typing import Any
 
 from . import schema as S
+from .builtin import resolve
+from .errors import SceneError
 
 
 MAX_STEPS = 1e12  # a run of more steps would take days; t_end / dt beyond it is a typo, not a plan
@@ -21,23 +23,9 @@ MAX_MAGNITUDE = 1e12  # in SI units: 7 AU, 30 000 years, a 1e12 N/m spring; no r
 MIN_POSITIVE = 1e-12  # the least value of a quantity that must be > 0, so that ratios such as k / m stay finite
 
 
-class SceneError(ValueError):
-    """A scene that cannot be used; ``str()`` is the one line to show the user."""
-
-    def __init__(self, source: str, key: str, message: str):
-        self.source, self.key, self.message = source, key, message
-        where = f"{source}: {key}: " if key else f"{source}: "
-        super().__init__(" ".join(f"{where}{message}".split()))
-
-    def __reduce__(self):   # picklable, so a sweep's worker process hands the real message back
-        return SceneError, (self.source, self.key, self.message)
-
-
 def load_scene(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> S.Scene:
     """Load and validate a scene file, or a built-in scene by name ("helicopter_mass"; a file that exists
     wins, see :mod:`ropesim.scene.builtin`), applying ``--set`` style ``KEY=VALUE`` overrides first."""
-    from .builtin import resolve
-
     found = resolve(path)
     path = found.path
     source = found.label
@@ -548,20 +536,28 @@ def _read_start(scene: S.Scene, base_dir: Path, fail) -> S.Scene:
         return scene
     import numpy as np
 
+    from ..io.frames import read_run
     from ..io.runfolder import RunFolderError
-    from ..io.trajectory import Trajectory
 
     folder = Path(init.run)
     folder = folder if folder.is_absolute() else base_dir / folder
     try:
-        traj = Trajectory.open(folder)
+        if not folder.is_dir():
+            raise RunFolderError(f"{folder}: no such run folder (make one with `ropesim run SCENE.toml`)")
+        arrays = read_run(folder)[0]
     except RunFolderError as exc:
         fail("initial.run", f"cannot start from it: {exc}")
+    if not {"t", "x", "v"} <= arrays.keys():
+        fail("initial.run", f"cannot start from it: {folder} saved no t, x and v arrays")
+    t, xs, vs = arrays["t"], arrays["x"], arrays["v"]
     n, dim = scene.rope.nodes, scene.dimension
-    if traj.x.shape[1:] != (n, dim):
-        fail("initial.run", f"{folder} holds {traj.x.shape[1]} nodes in {traj.x.shape[2]}-D, but this rope has "
-                            f"{n} nodes in {dim}-D")
-    t = np.asarray(traj.t)
+    if xs.ndim != 3 or vs.shape != xs.shape or xs.shape[0] != len(t):
+        fail("initial.run", f"cannot start from it: {folder}'s arrays do not fit together: t {t.shape}, x "
+                            f"{xs.shape}, v {vs.shape}")
+    if xs.shape[1:] != (n, dim):
+        fail("initial.run", f"{folder} holds {xs.shape[1]} nodes in {xs.shape[2]}-D, but this rope has {n} nodes in "
+                            f"{dim}-D")
+    t = np.asarray(t)
     if init.time is None:
         k = len(t) - 1
     else:
@@ -570,7 +566,7 @@ def _read_start(scene: S.Scene, base_dir: Path, fail) -> S.Scene:
             step = f", every {t[1] - t[0]:.6g} s" if len(t) > 1 else ""
             fail("initial.time", f"{folder} saved no frame at t = {init.time:g} s; it saved frames from "
                                  f"{t[0]:g} to {t[-1]:g} s{step} (nearest: {t[k]:.6g} s)")
-    x, v = np.asarray(traj.x[k], dtype=float), np.asarray(traj.v[k], dtype=float)
+    x, v = np.asarray(xs[k], dtype=float), np.asarray(vs[k], dtype=float)
     if not (np.all(np.isfinite(x)) and np.all(np.isfinite(v))):
         fail("initial.time", f"{folder}'s frame at t = {t[k]:g} s is not finite (the run blew up); choose an "
                              f"earlier one")

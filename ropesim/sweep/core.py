@@ -31,7 +31,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable
 
-from ..io.trajectory import SUMMARY, write_text_atomic
+from ..io.atomic import write_text_atomic
+from ..io.runfolder import SUMMARY
 from ..stop import Stopped
 from .plan import Point, SweepError, _numeric_axis, plan, toml_value
 from .points import Outcome, is_finished, run_local

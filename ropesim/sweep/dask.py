@@ -18,7 +18,8 @@ import numpy as np
 
 from .plan import Point, SweepError
 from .points import Outcome, _outcome, run_point_safely
-from ..io.trajectory import SCENE, SUMMARY, TRAJECTORY, write_json_atomic, write_npz_atomic, write_text_atomic
+from ..io.atomic import write_json_atomic, write_text_atomic
+from ..io.runfolder import SCENE, SUMMARY, TRAJECTORY, write_npz_atomic
 
 CONNECT_TIMEOUT = "20s"
 

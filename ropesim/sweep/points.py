@@ -11,7 +11,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 from typing import Callable, Iterator
 
-from ..io.trajectory import SCENE, SUMMARY, TRAJECTORY
+from ..io.runfolder import SCENE, SUMMARY, TRAJECTORY
 from ..scene.loader import scene_from_toml
 from .plan import Point
 
