@@ -21,6 +21,7 @@ import argparse
 import json
 import os
 import resource
+import signal
 import statistics
 import subprocess
 import sys
@@ -73,6 +74,7 @@ def main() -> None:
     parser.add_argument("--json", metavar="FILE", help="also write every measurement to FILE")
     args = parser.parse_args()
     methods = [m for m in args.methods.split(",") if m]
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))   # killed: still remove the temporary worktree
     results: dict[str, dict[str, list[dict]]] = {}
     with tempfile.TemporaryDirectory(prefix="ropesim-compile-") as tmp:
         work = Path(tmp)
