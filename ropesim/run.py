@@ -234,7 +234,8 @@ def frame_specs(model: Model) -> dict[str, tuple]:
 
 
 def simulate(scene: Scene, folder: str | Path | None = None, progress: bool = False, *,
-             stop: Callable[[], bool] | None = None, checkpoint_seconds: float = CHECKPOINT_SECONDS):
+             stop: Callable[[], bool] | None = None, checkpoint_seconds: float = CHECKPOINT_SECONDS,
+             before_bar: Callable[[], None] | None = None):
     """Run ``scene`` and return its :class:`~ropesim.trajectory.Trajectory`.
 
     With ``folder`` the run is written there as a transaction (:mod:`ropesim.io.runfolder`): frames stream to
@@ -243,7 +244,8 @@ def simulate(scene: Scene, folder: str | Path | None = None, progress: bool = Fa
     another process is writing is refused (:class:`~ropesim.io.runfolder.RunFolderBusy`). A run that blows up
     or is interrupted (Ctrl-C, SIGTERM, SIGHUP, or ``stop()`` returning True) stops cleanly: the trajectory
     holds every frame up to that point and ``summary["status"]`` says what happened; an interrupted run
-    continues with :func:`resume`.
+    continues with :func:`resume`. ``before_bar()`` is called just before the progress bar appears (the
+    command line's start-up spinner makes way for it).
     """
     from .io.runfolder import RunWriter
     from .scene.schema import scene_to_toml
@@ -251,13 +253,14 @@ def simulate(scene: Scene, folder: str | Path | None = None, progress: bool = Fa
     model = build(scene)
     grid = TimeGrid.of(scene)
     if folder is None:
-        return _run_in_memory(model, grid, progress, stop)
+        return _run_in_memory(model, grid, progress, stop, before_bar)
     writer = RunWriter.create(Path(folder), scene_to_toml(scene), frame_specs(model), _manifest_info(scene, grid))
-    return _run_in_folder(model, grid, writer, None, {}, progress, stop, checkpoint_seconds)
+    return _run_in_folder(model, grid, writer, None, {}, progress, stop, checkpoint_seconds, before_bar)
 
 
 def resume(folder: str | Path, t_end: float | None = None, progress: bool = False, *,
-           stop: Callable[[], bool] | None = None, checkpoint_seconds: float = CHECKPOINT_SECONDS):
+           stop: Callable[[], bool] | None = None, checkpoint_seconds: float = CHECKPOINT_SECONDS,
+           before_bar: Callable[[], None] | None = None):
     """Continue the run in ``folder`` from its last checkpoint; with ``t_end``, extend it (a finished run too).
 
     The result is bit for bit the run that was never stopped: frames, ledger, tension and summary (but for
@@ -289,7 +292,7 @@ def resume(folder: str | Path, t_end: float | None = None, progress: bool = Fals
             writer.manifest.update(_manifest_info(scene, grid), scene_sha256=scene_hash(new_text))
         integrator = make_integrator(model, grid)
         integrator.restore(state)
-        return _run_in_folder(model, grid, writer, integrator, cp, progress, stop, checkpoint_seconds)
+        return _run_in_folder(model, grid, writer, integrator, cp, progress, stop, checkpoint_seconds, before_bar)
     except BaseException:
         writer.close()
         raise
@@ -343,7 +346,7 @@ def _manifest_info(scene: Scene, grid: TimeGrid) -> dict:
                                           "frames": grid.frames, "t_end": scene.integrator.t_end}}
 
 
-def _run_in_memory(model: Model, grid: TimeGrid, progress: bool, stop) -> "Trajectory":
+def _run_in_memory(model: Model, grid: TimeGrid, progress: bool, stop, before_bar=None) -> "Trajectory":
     from .analysis.summary import summarize
     from .io.trajectory import FrameStore, Trajectory
     from .model.tension import frame_arrays
@@ -351,7 +354,7 @@ def _run_in_memory(model: Model, grid: TimeGrid, progress: bool, stop) -> "Traje
     specs = frame_specs(model)
     store = FrameStore(grid.frames, model.nodes, model.dim, derive=lambda t, x, v: frame_arrays(model, t, x, v),
                        shapes={k: s for k, s in specs.items() if k not in ("t", "x", "v", "ledger")})
-    with _progress(progress, model.scene) as on_progress:
+    with _progress(progress, model.scene, before_bar) as on_progress:
         outcome = integrate(model, store, on_progress, stop=stop)
     arrays = store.arrays()
     summary = summarize(model, outcome, arrays["t"], arrays["x"], arrays["v"], arrays["tension"])
@@ -444,7 +447,7 @@ class _DiskStore:
 
 
 def _run_in_folder(model: Model, grid: TimeGrid, writer, integrator: Integrator | None, previous: dict,
-                   progress: bool, stop, checkpoint_seconds: float):
+                   progress: bool, stop, checkpoint_seconds: float, before_bar=None):
     from .analysis.ledger import ledger_arrays
     from .analysis.summary import summarize
     from .io.runfolder import LEDGER, TRAJECTORY
@@ -454,7 +457,7 @@ def _run_in_folder(model: Model, grid: TimeGrid, writer, integrator: Integrator 
     writer.expected_frames = grid.frames
     store = _DiskStore(writer, model, checkpoint_seconds, previous)
     try:
-        with stop_signals() as flag, _progress(progress, model.scene) as on_progress:
+        with stop_signals() as flag, _progress(progress, model.scene, before_bar) as on_progress:
             outcome = integrate(model, store, on_progress, stop=stop, integrator=integrator, interrupted=flag,
                                 on_chunk=store.on_chunk)
             store.compile_time = outcome.compile_time
@@ -477,8 +480,9 @@ def _run_in_folder(model: Model, grid: TimeGrid, writer, integrator: Integrator 
 
 
 @contextmanager
-def _progress(enabled: bool, scene: Scene):
-    """A rich progress bar that appears only once a run has taken more than a second."""
+def _progress(enabled: bool, scene: Scene, before: Callable[[], None] | None = None):
+    """A rich progress bar that appears only once a run has taken more than a second; ``before()`` is called
+    just before it appears."""
     if not enabled:
         yield None
         return
@@ -493,6 +497,8 @@ def _progress(enabled: bool, scene: Scene):
                 return
             p = Progress(TextColumn(f"[bold]{scene.name}"), BarColumn(), TextColumn("t = {task.completed:.3g} s"),
                          TimeRemainingColumn(), transient=True)
+            if before is not None:
+                before()
             p.start()
             bar["p"], bar["task"] = p, p.add_task("run", total=t_end)
         bar["p"].update(bar["task"], completed=t)

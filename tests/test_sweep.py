@@ -246,6 +246,23 @@ def test_a_run_that_raises_is_recorded_with_its_error(tmp_path):
     assert error.startswith("SceneError: ") and "every scene needs a [initial] table" in error
 
 
+def test_a_method_several_runs_use_compiles_once_before_the_workers_start(monkeypatch, tmp_path):
+    """Workers would each compile the same loop at the same time; the sweep compiles (or loads) it once itself.
+    A method used by one run alone compiles in its worker, alongside the others."""
+    import ropesim.kernels
+
+    warmed = []
+    monkeypatch.setattr(ropesim.kernels, "warm_up", lambda scene: warmed.append(scene.integrator.method))
+    short = ["integrator.t_end=0.01"]
+    run_sweep(UNIFORM, ["integrator.method=verlet,pefrl", "drag.b=1,2", *short], out=tmp_path / "a", jobs=2,
+              quiet=True)
+    assert sorted(warmed) == ["pefrl", "verlet"]
+    warmed.clear()
+    run_sweep(UNIFORM, ["integrator.method=verlet,pefrl", *short], out=tmp_path / "b", jobs=2, quiet=True)
+    run_sweep(UNIFORM, ["drag.b=1,2", *short], out=tmp_path / "c", jobs=1, quiet=True)
+    assert warmed == []
+
+
 # ------------------------------------------------------------------------------------------- dask
 
 

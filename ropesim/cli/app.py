@@ -91,6 +91,13 @@ SetOpt = Annotated[Optional[list[str]], typer.Option(
          "E.g. --set integrator.dt=0.002 --set rope.nodes=61 --set overrides.0.mass=50.")]
 
 
+def _compiling(enabled: bool = True):
+    """On a terminal, a spinner while Numba compiles, saying what compiles (see :mod:`ropesim.cli.status`)."""
+    from .status import Startup
+
+    return Startup(enabled and sys.stderr.isatty()).watch()
+
+
 def fail(message: str, code: int = EXIT_BAD_INPUT) -> None:
     """Print one line to stderr and exit with ``code``."""
     typer.echo(f"ropesim: {message}", err=True)
@@ -160,38 +167,20 @@ def run(
     Frames stream to the folder in checkpoints; Ctrl-C, SIGTERM or SIGHUP stop the run at its next chunk and
     keep them, and `ropesim run --resume RUN_DIR` continues it.
     """
-    from .report import print_summary
-    from ..io.runfolder import DiskFull, RunFolderError
-    from ..run import BLEW_UP, INTERRUPTED, simulate
-
     progress = not quiet and sys.stderr.isatty()
-    if resume is not None:
-        if scene_file is not None or out is not None:
-            fail("--resume RUN_DIR continues the run in RUN_DIR: give no SCENE and no --out with it")
-        folder, where = resume, str(resume)
-        t_end = _resume_t_end(sets)
-        run_it = (lambda: _resume(folder, t_end, progress))
-    else:
-        if scene_file is None:
-            fail("missing SCENE: a scene file or a built-in scene's name (or --resume RUN_DIR)")
-        scene, where = _load(scene_file, sets)
-        _check_time_step(scene, where, force, quiet)
-        folder = out if out is not None else Path("runs") / scene.name
-        if folder.exists() and not folder.is_dir():
-            fail(f"--out {folder}: exists and is not a folder")
-        blocked = next((p for p in folder.parents if p.exists() and not p.is_dir()), None)
-        if blocked is not None:
-            fail(f"--out {folder}: cannot write the run folder: {blocked} is a file, not a folder")
-        _check_size(scene, where, folder, force, quiet)
-        run_it = (lambda: simulate(scene, folder, progress=progress))
-    try:
-        traj = run_it()
-    except DiskFull as exc:
-        fail(str(exc), EXIT_WRITE)
-    except RunFolderError as exc:
-        fail(str(exc))
-    except OSError as exc:
-        fail(f"{folder}: cannot write the run folder ({exc.strerror or exc})", EXIT_WRITE)
+    from .status import Startup, take_early
+
+    # On a terminal a spinner shows at once (before numpy and Numba load; from main() on, before Typer parsed
+    # the command line) and says what compiles, if anything.
+    status = take_early() or Startup(progress)
+    if not progress:
+        status.close()
+    status.update(f"Preparing {scene_file if resume is None else resume}")
+    with status:
+        traj, folder, where = _run_command(scene_file, out, sets, resume, quiet, force, progress, status)
+    from .report import print_summary
+    from ..run import BLEW_UP, INTERRUPTED
+
     summary = traj.summary
     if not quiet:
         print_summary(summary, folder)
@@ -204,6 +193,46 @@ def run(
              exit_code(name=by))
     if animate_:
         _animate(folder, None, quiet, fps=fps)
+
+
+def _run_command(scene_file, out, sets, resume, quiet, force, progress, status):
+    """`ropesim run`'s work up to the finished run: (trajectory, run folder, how to name it in messages)."""
+    from ..io.runfolder import DiskFull, RunFolderError
+    from ..run import simulate
+
+    if resume is not None:
+        if scene_file is not None or out is not None:
+            fail("--resume RUN_DIR continues the run in RUN_DIR: give no SCENE and no --out with it")
+        folder, where = resume, str(resume)
+        t_end = _resume_t_end(sets)
+        status.update(f"Resuming {folder}")
+        status.watch()
+        run_it = (lambda: _resume(folder, t_end, progress, status.stop))
+    else:
+        if scene_file is None:
+            fail("missing SCENE: a scene file or a built-in scene's name (or --resume RUN_DIR)")
+        scene, where = _load(scene_file, sets)
+        status.update(f"Preparing {scene.name}", kernel=f"the {scene.integrator.method} kernel")
+        status.watch()   # imports Numba, which the checks below need anyway
+        _check_time_step(scene, where, force, quiet)
+        folder = out if out is not None else Path("runs") / scene.name
+        if folder.exists() and not folder.is_dir():
+            fail(f"--out {folder}: exists and is not a folder")
+        blocked = next((p for p in folder.parents if p.exists() and not p.is_dir()), None)
+        if blocked is not None:
+            fail(f"--out {folder}: cannot write the run folder: {blocked} is a file, not a folder")
+        _check_size(scene, where, folder, force, quiet)
+        status.update(f"Running {scene.name}")
+        run_it = (lambda: simulate(scene, folder, progress=progress, before_bar=status.stop))
+    try:
+        traj = run_it()
+    except DiskFull as exc:
+        fail(str(exc), EXIT_WRITE)
+    except RunFolderError as exc:
+        fail(str(exc))
+    except OSError as exc:
+        fail(f"{folder}: cannot write the run folder ({exc.strerror or exc})", EXIT_WRITE)
+    return traj, folder, where
 
 
 def _resume_t_end(sets: list[str] | None) -> float | None:
@@ -223,10 +252,10 @@ def _resume_t_end(sets: list[str] | None) -> float | None:
     return t_end
 
 
-def _resume(folder: Path, t_end: float | None, progress: bool):
+def _resume(folder: Path, t_end: float | None, progress: bool, before_bar=None):
     from ..run import resume
 
-    return resume(folder, t_end, progress=progress)
+    return resume(folder, t_end, progress=progress, before_bar=before_bar)
 
 
 def _check_size(scene, where: str, folder: Path, force: bool, quiet: bool) -> None:
@@ -296,6 +325,39 @@ def check(scene_file: SceneArg, sets: SetOpt = None) -> None:
                    err=True)
 
 
+@app.command(cls=Command, name="compile")
+def compile_(
+    methods: Annotated[Optional[list[str]], typer.Option(
+        "--method", "-m", metavar="NAME", help="Compile only this integrator's kernels; repeatable or "
+                                               "comma-separated (default: every integrator, and the static "
+                                               "solver).", show_default=False)] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")] = False,
+) -> None:
+    """Compile every kernel into Numba's cache now, so that later runs start at once: for container images and CI.
+
+    A run compiles its integrator's time loop the first time (8 to 30 s, once; then it loads from the cache
+    in a fraction of a second). This compiles the loop of every integrator for every built-in scene, the
+    tension and support forces of a saved frame, and the static solver of initial.shape = "equilibrium", then
+    prints what it compiled and how long each took. The cache is the folder ropesim chose for this
+    installation (or NUMBA_CACHE_DIR): run it as the user who will run ropesim, on the same kind of CPU.
+    """
+    from .report import print_compiled
+    from .status import Startup, cache_dir
+    from ..kernels import STATIC_SOLVER, compile_all
+
+    names = _methods(",".join(methods), "--method") if methods else None
+    with Startup(not quiet and sys.stderr.isatty(), "ropesim compile") as status:
+        status.watch()
+
+        def starting(name: str, i: int, n: int) -> None:
+            what = "the static solver" if name == STATIC_SOLVER else f"the {name} kernel"
+            status.update(f"Loading {what} ({i + 1} of {n})", kernel=what)
+
+        results = compile_all(names, static_solver=names is None, on_start=starting)
+    if not quiet:
+        print_compiled(results, cache_dir())
+
+
 @app.command(cls=Command)
 def equilibrium(
     scene_file: SceneArg,
@@ -324,7 +386,8 @@ def equilibrium(
             fail(f"--out {out}: must name a .toml file")
         if out.exists() and not force:
             fail(f"--out {out}: exists; choose another file or add --force to replace it")
-    shape = solve(scene)
+    with _compiling():   # the static solver compiles on its first use
+        shape = solve(scene)
     print_equilibrium(shape, where)
     if not shape.converged:
         fail(f"{where}: the static solve did not converge (largest residual force {shape.residual:.3g} N after "
@@ -415,8 +478,9 @@ def sweep(
     from ..sweep.plan import SweepError
 
     try:
-        result = run_sweep(_source(scene_file).path, sets or [], out=out, jobs=jobs, scheduler=scheduler,
-                           plots=plots or [], quiet=quiet)
+        with _compiling(not quiet):   # the sweep compiles each method's kernels once before its workers start
+            result = run_sweep(_source(scene_file).path, sets or [], out=out, jobs=jobs, scheduler=scheduler,
+                               plots=plots or [], quiet=quiet)
     except SweepError as exc:
         fail(str(exc))
     if not quiet:
@@ -669,15 +733,15 @@ def _warn_ladder(scene, steps: dict[str, float], command: str) -> None:
                    f"computing; Ctrl-C stops it", err=True)
 
 
-def _methods(text: str | None) -> list[str] | None:
+def _methods(text: str | None, option: str = "--methods") -> list[str] | None:
     from ..integrate.methods import METHODS
 
     if not text:
         return None
-    names = [n.strip() for n in text.split(",") if n.strip()]
+    names = list(dict.fromkeys(n.strip() for n in text.split(",") if n.strip()))
     bad = [n for n in names if n not in METHODS]
     if bad or not names:
-        fail(f"--methods {text}: unknown integrator {', '.join(bad) or '(none)'}; allowed {', '.join(METHODS)}")
+        fail(f"{option} {text}: unknown integrator {', '.join(bad) or '(none)'}; allowed {', '.join(METHODS)}")
     return names
 
 
@@ -724,7 +788,8 @@ def accuracy(
     steps["pefrl"] = steps.get("pefrl", 0) + 1.5 * t_end / (min(rungs) / 16)     # the reference
     _warn_ladder(scene, steps, "accuracy")
     try:
-        report = accuracy_report(scene, names, ladder, repeats)
+        with _compiling():
+            report = accuracy_report(scene, names, ladder, repeats)
     except (KeyboardInterrupt, Stopped) as exc:
         fail("accuracy interrupted; nothing written", exit_code(exc))
     try:
@@ -767,7 +832,8 @@ def stability(
     probes = (len(ladder or range(20)) + 20) * len(ks or [0])       # the ladder and about 20 bisection probes
     _warn_ladder(scene, {m: probes * steps for m in (names or METHOD_NAMES)}, "stability")
     try:
-        result = stability_sweep(scene, names, ladder, ks, steps)
+        with _compiling():
+            result = stability_sweep(scene, names, ladder, ks, steps)
     except (KeyboardInterrupt, Stopped) as exc:
         fail("stability interrupted; nothing written", exit_code(exc))
     try:
@@ -792,12 +858,18 @@ def main() -> None:
     for name in ("SIGTERM", "SIGHUP"):
         if hasattr(signal, name):
             signal.signal(getattr(signal, name), _raise_stopped)
+    from .status import close_early, start_early
+
+    start_early(sys.argv[1:])   # `ropesim run` on a terminal: its spinner, before Typer parses (0.15 s)
     try:
         app()
     except (KeyboardInterrupt, Stopped) as exc:
+        close_early()
         name = exc.name if isinstance(exc, Stopped) else "SIGINT"
         typer.echo(f"ropesim: {'interrupted' if name == 'SIGINT' else f'stopped by {name}'}", err=True)
         sys.exit(exit_code(exc))
+    finally:
+        close_early()   # Typer refused the command line before `run` took the spinner
 
 
 if __name__ == "__main__":  # pragma: no cover

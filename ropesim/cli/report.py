@@ -48,6 +48,25 @@ def print_figures(console: Console, title: str, columns: list[str], rows: list[l
         console.print(table)
 
 
+def print_compiled(results, cache: str) -> None:
+    """What ``ropesim compile`` did, per integrator (and the static solver): time and functions compiled."""
+    rows = []
+    for r in results:
+        if r.functions:
+            what = f"compiled {r.functions} function{'s' if r.functions != 1 else ''}"
+        elif r.shared_with:
+            what = f"shares the loop of {r.shared_with}"
+        else:
+            what = "in the cache already"
+        rows.append([r.name, r.family, f"{r.seconds:.1f}", what])
+    console = _console()
+    print_figures(console, f"kernels in {cache}", ["kernel", "family", "time [s]", "what happened"], rows, keys=1,
+                  left=(0, 1, 3))
+    scenes = max((r.scenes for r in results if r.family != "statics"), default=0)
+    console.print(f"each integrator made ready for {scenes} built-in scene{'s' if scenes != 1 else ''} (its loop "
+                  f"serves every scene): runs load it from the cache instead of compiling")
+
+
 def print_summary(summary: dict, folder: Path) -> None:
     """The run summary as a two-column table."""
     table = Table(title=f"{summary['scene']}: {summary['status']}", show_header=False, title_justify="left")

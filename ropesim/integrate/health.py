@@ -118,7 +118,8 @@ def verdict(energy, stretch, node, x, v, ledger, limits):
 def save_frame(frame, t, x, v, ledger, frames_t, frames_x, frames_v, frames_w):
     frames_t[frame] = t
     dim, n = x.shape
-    for d in range(dim):   # element by element: a slice assignment may copy its source, which needs an allocation
+    for d in range(dim):   # element by element: a slice assignment may copy its source, which needs an allocation,
+        # and compiles Numba's shape-mismatch message (seconds of a first run's compile)
         for i in range(n):
             frames_x[frame, d, i] = x[d, i]
             frames_v[frame, d, i] = v[d, i]

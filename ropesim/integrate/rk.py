@@ -145,7 +145,7 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
     dim, n = x.shape
     stages = b.shape[0]
     has_box = any_applied(params.flags)
-    frame = 0
+    frame = np.int64(0)   # not the literal 0: Numba would compile the frame saving twice (for 0, then int64)
     for s in range(schedule.n_steps):
         step = schedule.step0 + s
         t = step * h

@@ -251,7 +251,7 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
     dim, n = x.shape
     has_box = any_applied(params.flags)
     beta = GAMMA * h
-    frame = 0
+    frame = np.int64(0)   # not the literal 0: Numba would compile the frame saving twice (for 0, then int64)
     for s in range(schedule.n_steps):
         step = schedule.step0 + s
         t = step * h

@@ -244,7 +244,7 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
     if is_plain and not closed:
         fx[0] = fx[n] = fy[0] = fy[n] = 0.0
     held_work = ledger[HELD]   # kept in a register, stored whenever the ledger is read
-    frame = 0
+    frame = np.int64(0)   # not the literal 0: Numba would compile the frame saving twice (for 0, then int64)
     next_check = step0 + check_every - step0 % check_every   # counted, not divided, per step
     next_save = step0 + save_every - step0 % save_every
     for s in range(n_steps):

@@ -142,16 +142,25 @@ def run_sweep(scene_file: str | Path, sets: list[str], out: str | Path | None = 
     result = SweepResult(rows=[], csv_path=root / RESULTS, swept=swept, skipped=len(done), ran=len(todo))
     from .progress import SweepProgress
 
+    stopped = None
+    workers = min(jobs or os.cpu_count() or 1, len(todo))
+    if workers > 1 and scheduler is None:
+        try:
+            warm_up([p for p, _ in todo])
+        except (KeyboardInterrupt, Stopped) as exc:
+            stopped = exc
     with SweepProgress(len(points), quiet) as progress:
         progress.skipped(len(done), root)
         try:
+            if stopped is not None:
+                raise stopped
             if todo:
                 if scheduler is not None:
                     from .dask import run_dask
 
                     results = run_dask(todo, scheduler)
                 else:
-                    results = run_local(todo, min(jobs or os.cpu_count() or 1, len(todo)))
+                    results = run_local(todo, workers)
                 with closing(results):
                     for outcome in results:
                         outcomes[outcome[0].name] = outcome
@@ -169,6 +178,32 @@ def run_sweep(scene_file: str | Path, sets: list[str], out: str | Path | None = 
         for figure in plots:
             result.plots.append(plot_figure(result.rows, axes, figure, root, title=base.name))
     return result
+
+
+def warm_up(points: list[Point]) -> None:
+    """Compile (or load from the cache) here, once, the kernels of each method that several points use, so that
+    the workers load them from Numba's cache instead of compiling the same loop at the same time (methods used
+    once compile in their workers, in parallel). A point whose scene fails here is left to its own run to
+    report."""
+    from ..kernels import warm_up as warm_scene
+    from .points import scene_from_toml
+
+    first: dict[str, object] = {}
+    uses: dict[str, int] = {}
+    for point in points:
+        try:
+            scene = scene_from_toml(point.scene_toml)
+        except Exception:
+            continue
+        method = scene.integrator.method
+        first.setdefault(method, scene)
+        uses[method] = uses.get(method, 0) + 1
+    for method, scene in first.items():
+        if uses[method] > 1:
+            try:
+                warm_scene(scene)
+            except Exception:
+                pass
 
 
 def _final_row(point: Point, folder: Path, outcome: Outcome | None) -> dict:
