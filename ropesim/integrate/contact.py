@@ -21,10 +21,10 @@ import math
 
 from ..model.forces.thrower import box_of, smooth_step, weight_at
 from ..model.terms import GUIDES, THROWER
-from ..model.jit import kernel
+from ..model import jit
 
 
-@kernel
+@jit.kernel
 def _phi(lam, tau):
     """(1 - e^(-lam tau)) / lam, and tau at lam = 0."""
     z = lam * tau
@@ -33,7 +33,7 @@ def _phi(lam, tau):
     return -math.expm1(-z) / lam
 
 
-@kernel
+@jit.kernel
 def contact_rates(x, v, i, inv_mass, flags, thrower, guides, box, three_d):
     """The rates [1/s] (gxx, gxy, gyy, gzz) of the velocity-linear forces the box and the circles put on node
     ``i``: the drive's and the centring's along and across the box (rotated by the launch angle), and each
@@ -78,7 +78,7 @@ def contact_rates(x, v, i, inv_mass, flags, thrower, guides, box, three_d):
     return gxx, gxy, gyy, gzz
 
 
-@kernel
+@jit.kernel
 def kick_exactly(v, acc, out, i, g, gxx, gxy, gyy, gzz, tau):
     """Node ``i``'s velocity after an exact kick of length ``tau`` under dv/dt = b - A v into ``out[:, i]``:
     A = g I + the contact rates, b = acc + the rates times v (the contact forces' constant part)."""
@@ -104,7 +104,7 @@ def kick_exactly(v, acc, out, i, g, gxx, gxy, gyy, gzz, tau):
         out[2, i] = math.exp(-lz * tau) * v[2, i] + _phi(lz, tau) * (acc[2, i] + gzz * v[2, i])
 
 
-@kernel
+@jit.kernel
 def exact_contact_kicks(x, v, acc, out, nodes, tau, gamma, free, forces):
     """For every free node the box or a circle touches, its velocity after an exact kick of length ``tau``
     into ``out[:, i]``, its index into ``nodes``; returns how many. ``acc`` is a(x, v) without drag and

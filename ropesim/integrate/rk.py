@@ -19,7 +19,7 @@ import numpy as np
 from ..model.terms import ADDED_MASS, accelerations, added_mass, any_applied, applied_accelerations
 from .base import Integrator, Method
 from .health import BOX, DRAG, FLUID, HELD, INTERNAL, OK, SEABED, due, end_step, held_power, place, power
-from ..model.jit import kernel
+from ..model import jit
 
 
 @dataclass(frozen=True)
@@ -98,7 +98,7 @@ class RungeKuttaFamily(Integrator):
                           m.params, self.limits, self.schedule(n), frames)
 
 
-@kernel
+@jit.kernel
 def stage_state(x, v, kx, kv, a, st, h, xs, vs):
     """Stage ``st``'s state into ``xs``, ``vs``: x + h sum_j a[st, j] kx[j], and the same for v."""
     dim, n = x.shape
@@ -115,7 +115,7 @@ def stage_state(x, v, kx, kv, a, st, h, xs, vs):
             vs[d, i] = pv
 
 
-@kernel
+@jit.kernel
 def combine(x, v, kx, kv, b, h):
     """The step's end: x += h sum_s b[s] kx[s], and the same for v."""
     dim, n = x.shape
@@ -130,7 +130,7 @@ def combine(x, v, kx, kv, b, h):
             v[d, i] += h * dv
 
 
-@kernel
+@jit.kernel
 def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedule, frames):
     """Advance ``schedule.n_steps`` Runge-Kutta steps in place; the contract of :mod:`ropesim.integrate.base`.
 

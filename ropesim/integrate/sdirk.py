@@ -36,7 +36,7 @@ from ..model.terms import (ADDED_MASS, accelerations, added_mass, any_applied, a
 from ..model.banded import factor, solve, woodbury
 from .base import Integrator, Method
 from .health import BOX, DRAG, FLUID, HELD, INTERNAL, NEWTON_FAILED, OK, SEABED, due, end_step, held_power, place, power
-from ..model.jit import kernel
+from ..model import jit
 
 GAMMA = 1.0 - 1.0 / math.sqrt(2.0)
 NEWTON_TOL = 1e-11      # Newton stops when no free node's position changes by more than this times l
@@ -126,7 +126,7 @@ class SdirkFamily(Integrator):
                              self.nodes, self.model.params, self.limits, self.schedule(n), frames)
 
 
-@kernel
+@jit.kernel
 def stage_residual(stage, rhs, beta, t_stage, held, nodes, params):
     """At the stage's positions X, with V = (X - xh) / beta (held nodes: their own velocity), write minus the
     residual of m (V - vh) = beta (a(X, V) m - b V) (plus A_i (V - vh) with added mass), times beta, into
@@ -166,7 +166,7 @@ def stage_residual(stage, rhs, beta, t_stage, held, nodes, params):
     return norm, fluid, internal, seabed
 
 
-@kernel
+@jit.kernel
 def take_update(X, rhs, step):
     """X += the Newton update in ``rhs``, kept in ``step``. Returns (its largest component [m], that node)."""
     dim, n = X.shape
@@ -183,7 +183,7 @@ def take_update(X, rhs, step):
     return worst, worst_node
 
 
-@kernel
+@jit.kernel
 def take_back_half(X, step):
     """Halve the last update ``step`` and take that half back from X."""
     dim, n = X.shape
@@ -193,7 +193,7 @@ def take_back_half(X, step):
             X[d, i] -= step[i * dim + d]
 
 
-@kernel
+@jit.kernel
 def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     """Newton solve of one stage: X = xh + beta V, V = vh + beta (a(X, V) - gamma V). Returns
     (iterations, node, fluid power [W], internal-damping power [W]): iterations < 0 when it failed, naming the
@@ -237,7 +237,7 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     return -1, worst_node, 0.0, 0.0, 0.0
 
 
-@kernel
+@jit.kernel
 def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, frames):
     """Advance ``schedule.n_steps`` SDIRK2 steps in place; the contract of :mod:`ropesim.integrate.base`.
 

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.jit import kernel
+from ..model import jit
 from ..model.terms import GRAVITY, accelerations, has_applied, applied_accelerations, mechanical_energy, position_accelerations
 from .base import Integrator, Method
 from .contact import exact_contact_kicks
@@ -215,7 +215,7 @@ class Splitting(Integrator):
                                  self.limits, self.schedule(n), frames)
 
 
-@kernel
+@jit.kernel
 def advance_splitting(state, kicks, plain, general, held, mass, params, limits, schedule, frames):
     """Advance ``schedule.n_steps`` splitting steps in place, from global step ``schedule.step0``.
 

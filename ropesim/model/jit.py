@@ -1,6 +1,8 @@
 """How ropesim compiles its kernels: one decorator for every function the integration loops call.
 
-``kernel`` is Numba's ``njit`` in nopython mode with three settings fixed for the whole code base:
+``kernel`` (used as ``@jit.kernel``, the module named at every use so that a reader, and
+``../shared/tools/shape.py``, sees a compiled function) is Numba's ``njit`` in nopython mode with three
+settings fixed for the whole code base:
 
 - ``cache=True``: compiled machine code is kept on disk (see :mod:`ropesim.io.numba_cache`), so only the
   first run of a scene's methods compiles;

@@ -21,7 +21,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from .jit import kernel
+from . import jit
 
 Motion = namedtuple("Motion", ["moving", "base", "amp", "omega", "phase", "ramp", "path_t", "path_d", "span", "accel"])
 
@@ -54,7 +54,7 @@ def motion_of(scene, held_idx: np.ndarray) -> Motion:
                   np.zeros((dim, h)))
 
 
-@kernel(inline="always")
+@jit.kernel(inline="always")
 def ramp_factor(t, ramp):
     """(r, dr/dt, d2r/dt2) of the ramp r = 10 s^3 - 15 s^4 + 6 s^5, s = t / T, until T, 1 after (and always
     when T = 0): "smootherstep", whose rate and acceleration are zero at both ends, so the held node's
@@ -68,7 +68,7 @@ def ramp_factor(t, ramp):
             u * (60.0 + u * (-180.0 + 120.0 * u)) / (ramp * ramp))
 
 
-@kernel
+@jit.kernel
 def offset(m, j, d, t):
     """(position, velocity, acceleration) of held node j's motion along axis d at time t, beyond x0 + V t."""
     s = ds = dds = 0.0
@@ -92,7 +92,7 @@ def offset(m, j, d, t):
     return r * s, dr * s + r * ds, ddr * s + 2.0 * dr * ds + r * dds
 
 
-@kernel
+@jit.kernel
 def place_moving(x, v, held, t):
     """Put every held node at its prescribed place at time t, set its velocity in ``v`` and in ``held.v``,
     and its acceleration in ``held.motion.accel``."""

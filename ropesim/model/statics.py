@@ -37,7 +37,7 @@ import numpy as np
 from .banded import factor, solve, woodbury
 from .jacobian import Jacobian, band_width
 from .terms import accelerations, coupling_reach, mechanical_energy, newton_matrix, velocity_accelerations
-from .jit import kernel
+from . import jit
 
 TOL = 1e-10
 MAX_ITERATIONS = 2000
@@ -54,7 +54,7 @@ class Equilibrium:
     converged: bool
 
 
-@kernel
+@jit.kernel
 def _forces(x, v, acc, p, t, mass, free, out):
     """The net static force [N] on every free node (0 on held nodes) into ``out`` (flat, node-major); returns
     its largest component."""
@@ -140,7 +140,7 @@ def _energy(x, v, mass, p) -> float:
     return float(mechanical_energy(x, v, mass, p)[0])
 
 
-@kernel
+@jit.kernel
 def _nonconservative(x, v, acc, p, t, mass, free, out):
     """The force [N] of the terms that are not conservative (drag in the flow; the others vanish at rest) on
     every free node into ``out`` (flat, node-major)."""

@@ -44,7 +44,7 @@ from .forces.seabed import (SEABED_TERM, add_seabed_contact, add_seabed_friction
 from .forces.thrower import THROWER as THROWER_TERM
 from .forces.thrower import add_thrower, add_thrower_jacobian
 from .jacobian import pair_damper_blocks, pair_spring_blocks
-from .jit import kernel
+from . import jit
 
 TERMS = (ROPE, BENDING_TERM, GRAVITY_TERM, BUOYANCY_TERM, THROWER_TERM, GUIDES_TERM, AXIAL_DAMPING_TERM,
          FLUID_DRAG_TERM, VISCOUS_DRAG_TERM, BODY_DRAG_TERM, FLOW_TERM, FLOW_PUSH_TERM, ADDED_MASS_TERM, SEABED_TERM,
@@ -102,20 +102,20 @@ def has_applied(p: ModelParams) -> bool:
     return bool(p.flags[THROWER] or p.flags[GUIDES])
 
 
-@kernel(inline="always")
+@jit.kernel(inline="always")
 def any_applied(flags):
     """True when a term of the ledger's ``box_work`` (the thrower, the guides) is on."""
     return flags[THROWER] != 0 or flags[GUIDES] != 0
 
 
-@kernel(inline="always")
+@jit.kernel(inline="always")
 def any_fluid(flags):
     """True when a term acting through the fluid (drag on the relative velocity, a flow's push) is on."""
     return (flags[FLUID_DRAG] != 0 or flags[VISCOUS_DRAG] != 0 or flags[BODY_DRAG] != 0
             or flags[FLOW_PUSH] != 0)
 
 
-@kernel
+@jit.kernel
 def position_accelerations(x, acc, p):
     """Overwrite ``acc`` (D, N) with the acceleration [m/s^2] of the terms that depend on positions alone."""
     closed = p.spring[2] != 0.0
@@ -131,7 +131,7 @@ def position_accelerations(x, acc, p):
         add_ei_bending(x, acc, p.inv_mass, p.bending_ei, closed)
 
 
-@kernel
+@jit.kernel
 def velocity_accelerations(x, v, acc, p, t):
     """Add the acceleration [m/s^2] of the terms that depend on velocities or time (the thrower, the guides,
     axial damping, fluid forces, the accelerating water's, the seabed's damping and friction) at time t [s];
@@ -156,7 +156,7 @@ def velocity_accelerations(x, v, acc, p, t):
     return fluid, internal, seabed
 
 
-@kernel
+@jit.kernel
 def accelerations(x, v, acc, p, t):
     """Overwrite ``acc`` (D, N) with every term's force / m [m/s^2] at time t [s], the linear [drag] b v and
     added mass excluded; returns the power [W] of the fluid, the axial damping and the seabed."""
@@ -164,7 +164,7 @@ def accelerations(x, v, acc, p, t):
     return velocity_accelerations(x, v, acc, p, t)
 
 
-@kernel
+@jit.kernel
 def added_mass(x, v, acc, p):
     """With added mass on, turn ``acc`` (every force / m, drag included) into M^-1 F; returns the power [W] of
     the fluid's inertial force (0 without added mass)."""
@@ -173,7 +173,7 @@ def added_mass(x, v, acc, p):
     return 0.0
 
 
-@kernel
+@jit.kernel
 def applied_accelerations(x, v, out, p):
     """Overwrite ``out`` (D, N) with the non-conservative terms' part of the acceleration [m/s^2] alone (the
     thrower's and guides'); zero when none is on. The energy ledger books their work as ``box_work``."""
@@ -185,7 +185,7 @@ def applied_accelerations(x, v, out, p):
         add_guides(x, v, out, p.guides, p.thrower, p.flags[THROWER] != 0, g)
 
 
-@kernel
+@jit.kernel
 def _springs_energy_and_stretch(x, k, rest, stride, closed, slack):
     dim, n = x.shape
     count = n if closed else n - stride
@@ -209,7 +209,7 @@ def _springs_energy_and_stretch(x, k, rest, stride, closed, slack):
     return energy, worst / rest, where
 
 
-@kernel
+@jit.kernel
 def mechanical_energy(x, v, mass, p):
     """(kinetic + spring + bending + gravitational + buoyancy energy [J], largest spring length / rest length,
     its node). Checked every few steps by the run loop to catch a blow-up (runaway energy or an insane
@@ -235,7 +235,7 @@ def mechanical_energy(x, v, mass, p):
     return e, stretch, node
 
 
-@kernel
+@jit.kernel
 def coupling_jacobian(x, jac, beta, free, p):
     """Add the coupling terms' blocks for a stage of coefficient beta = gamma h: beta^2 times the springs' and
     bending's stiffness, beta times the axial damping."""
@@ -250,7 +250,7 @@ def coupling_jacobian(x, jac, beta, free, p):
         add_ei_jacobian(x, jac, beta, free, p.bending_ei, p.spring[1], closed)
 
 
-@kernel
+@jit.kernel
 def node_jacobian(x, v, band, beta, mass, free, p, t):
     """Add the node-local terms' blocks (the thrower's, the guides', the fluid's, added mass) to the Newton
     matrix's ``band``, for a stage of coefficient beta = gamma h at time t (see :mod:`ropesim.model.jacobian`)."""
@@ -266,7 +266,7 @@ def node_jacobian(x, v, band, beta, mass, free, p, t):
         add_seabed_jacobian(x, v, band, beta, free, p.seabed, True)
 
 
-@kernel
+@jit.kernel
 def newton_matrix(x, v, jac, beta, nodes, p, t):
     """The matrix M (1 + beta gamma) + beta^2 H + beta C_v into ``jac`` (:mod:`ropesim.model.jacobian`): the
     mass and linear drag on the diagonal, then every term's blocks. ``nodes`` = (free (N,) bool, mass (N,),

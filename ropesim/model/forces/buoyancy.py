@@ -12,12 +12,12 @@ import math
 import numpy as np
 
 from . import Term
-from ..jit import kernel
+from .. import jit
 
 BUOYANCY = 5   # its flag
 
 
-@kernel
+@jit.kernel
 def add_buoyancy(acc, up):
     """Add each node's upward acceleration ``up`` [m/s^2] (along +y)."""
     for i in range(up.shape[0]):

@@ -33,12 +33,12 @@ from .added_mass import ADDED_MASS_TERM
 from .added_mass import _params as added_mass_params
 from .buoyancy import displaced_volume
 from .fluid import flow_scaled, node_tangent
-from ..jit import kernel
+from .. import jit
 
 FLOW_INERTIA = 14   # its flag
 
 
-@kernel
+@jit.kernel
 def ramp_rate(t, ramp_time):
     """The rate r'(t) [1/s] of the flow's ramp r(t) = (1 - cos(pi t / T)) / 2 (0 before 0 and after T)."""
     if ramp_time <= 0.0 or t <= 0.0 or t >= ramp_time:
@@ -46,7 +46,7 @@ def ramp_rate(t, ramp_time):
     return 0.5 * math.pi / ramp_time * math.sin(math.pi * t / ramp_time)
 
 
-@kernel
+@jit.kernel
 def add_flow_inertia(x, v, acc, inv_mass, inertia, flow, t, closed):
     """Add the accelerating water's force (see the module doc) at time t [s] as accelerations [m/s^2]; returns
     its power [W] on the nodes moving at ``v``."""

@@ -31,7 +31,7 @@ import math
 import numpy as np
 
 from . import Term
-from ..jit import kernel
+from .. import jit
 
 FLUID_DRAG, VISCOUS_DRAG, BODY_DRAG, FLOW, FLOW_PUSH = 6, 7, 8, 9, 10   # their flags (Term.flag below)
 UNIFORM, POWER_LAW, TABLE = 0, 1, 2
@@ -39,7 +39,7 @@ PROFILES = {"uniform": UNIFORM, "power_law": POWER_LAW, "table": TABLE}
 FLOW_PARAMS = 8
 
 
-@kernel
+@jit.kernel
 def ramp(t, ramp_time):
     """The flow's ramp factor at time t [s]: (1 - cos(pi t / T)) / 2 until T, then 1."""
     if ramp_time <= 0.0 or t >= ramp_time:
@@ -49,13 +49,13 @@ def ramp(t, ramp_time):
     return 0.5 * (1.0 - math.cos(math.pi * t / ramp_time))
 
 
-@kernel
+@jit.kernel
 def flow_at(y, t, flow, table):
     """The flow velocity (Ux, Uy, Uz) [m/s] at height y [m] and time t [s] (see the module doc)."""
     return flow_scaled(y, ramp(t, flow[1]), flow, table)
 
 
-@kernel
+@jit.kernel
 def flow_scaled(y, s, flow, table):
     """The flow's full profile at height y [m] times s: its velocity with s the ramp's factor, its local
     acceleration with s the ramp's rate."""
@@ -83,7 +83,7 @@ def flow_scaled(y, s, flow, table):
     return s * flow[5], s * flow[6], s * flow[7]
 
 
-@kernel(inline="always")
+@jit.kernel(inline="always")
 def node_tangent(x, i, closed):
     """The unit tangent (qx, qy, qz) of node i (see the module doc); (0, 0, 0) when it has none."""
     dim, n = x.shape
@@ -101,7 +101,7 @@ def node_tangent(x, i, closed):
     return qx / r, qy / r, qz / r
 
 
-@kernel
+@jit.kernel
 def add_fluid_forces(x, v, acc, p, t):
     """Add the fluid forces (see the module doc) of every free-or-held node as accelerations [m/s^2]; returns
     their power [W] on the rope (held nodes included: their supports take it)."""
@@ -158,7 +158,7 @@ def add_fluid_forces(x, v, acc, p, t):
 
 
 
-@kernel
+@jit.kernel
 def add_fluid_jacobian(x, v, band, beta, free, p, t):
     """Add beta C to the Newton matrix's node blocks (see :mod:`ropesim.model.jacobian`), C = -dF/dv the fluid
     forces' damping at the current state, with the tangent frozen (its dependence on positions is left out):

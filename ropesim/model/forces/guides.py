@@ -18,12 +18,12 @@ import numpy as np
 from . import Term
 
 from .thrower import box_of, smooth_step, weight_at
-from ..jit import kernel
+from .. import jit
 
 GUIDE_PARAMS = 7
 
 
-@kernel
+@jit.kernel
 def add_guides(x, v, acc, circles, box, has_box, g):
     """Add the guide circles' accelerations [m/s^2]; ``box`` is the thrower's parameters if ``has_box``."""
     n = x.shape[1]
@@ -60,7 +60,7 @@ def add_guides(x, v, acc, circles, box, has_box, g):
 
 
 
-@kernel
+@jit.kernel
 def add_guides_jacobian(x, v, band, beta, mass, free, circles, box, has_box):
     """Add the circles' node blocks to the stiff integrator's Newton matrix (see :mod:`ropesim.model.jacobian`).
 

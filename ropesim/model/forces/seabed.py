@@ -34,20 +34,20 @@ import numpy as np
 
 from . import Term
 from .fluid import node_tangent
-from ..jit import kernel
+from .. import jit
 
 SEABED = 12   # its flag
 SEABED_PARAMS = 10
 DAMPING_DEPTH = 1e-3   # delta_d / the footprint's width: the depth over which the contact damping grows
 
 
-@kernel(inline="always")
+@jit.kernel(inline="always")
 def depth(px, py, bed):
     """How far a point is sunk below the plane along its normal [m] (negative above it)."""
     return (bed[0] + bed[1] * px - py) * bed[2]
 
 
-@kernel
+@jit.kernel
 def add_seabed_contact(x, acc, inv_mass, seabed):
     """Add the contact spring's acceleration k delta A n / m [m/s^2] of every node in contact."""
     bed, area = seabed
@@ -61,7 +61,7 @@ def add_seabed_contact(x, acc, inv_mass, seabed):
             acc[1, i] += f * ny
 
 
-@kernel
+@jit.kernel
 def add_seabed_friction(x, v, acc, inv_mass, seabed, closed):
     """Add the contact damping and friction (see the module doc) as accelerations; returns their power [W]."""
     bed, area = seabed
@@ -103,7 +103,7 @@ def add_seabed_friction(x, v, acc, inv_mass, seabed, closed):
     return power
 
 
-@kernel
+@jit.kernel
 def seabed_energy(x, seabed):
     """The contact springs' energy, sum of k delta^2 A / 2 [J]."""
     bed, area = seabed
@@ -115,7 +115,7 @@ def seabed_energy(x, seabed):
     return e
 
 
-@kernel
+@jit.kernel
 def add_seabed_jacobian(x, v, band, beta, free, seabed, friction):
     """Add each contact's node block to the Newton matrix (:mod:`ropesim.model.jacobian`): beta^2 k A n n^T;
     on a node moving in, the damping's beta c A f n n^T and, where it grows with depth (delta < delta_d), the

@@ -26,13 +26,13 @@ import math
 import numpy as np
 
 from . import Term
-from ..jit import kernel
+from .. import jit
 
 THROWER_PARAMS = 12
 SMOOTH_CUTOFF = 20.0  # beyond 20 widths tanh is 1 to double precision: the weight is exactly 0 or 1
 
 
-@kernel
+@jit.kernel
 def smooth_step(d, w):
     """The indicator of d > 0, smoothed over a width w: (1 + tanh(d / w)) / 2; the sharp step when w = 0."""
     if w == 0.0:
@@ -45,7 +45,7 @@ def smooth_step(d, w):
     return 0.5 * (1.0 + math.tanh(z))
 
 
-@kernel
+@jit.kernel
 def box_of(p):
     """The box's centre, half-length, half-width, edge width and direction (cx, cy, cz, L/2, W/2, w, cos alpha,
     sin alpha), a tuple of floats.
@@ -57,7 +57,7 @@ def box_of(p):
     return p[0], p[1], p[2], p[3], p[4], p[9], p[10], p[11]
 
 
-@kernel
+@jit.kernel
 def weight_at(px, py, pz, three_d, box):
     """How much a node at (px, py[, pz]) is inside the box ``box`` (see :func:`box_of`), 0 to 1 (exactly 0 or 1
     with sharp edges); ``pz`` is ignored unless ``three_d``."""
@@ -79,14 +79,14 @@ def weight_at(px, py, pz, three_d, box):
     return s
 
 
-@kernel
+@jit.kernel
 def box_weight(x, i, p):
     """How much node i is inside the box, 0 to 1 (exactly 0 or 1 with sharp edges)."""
     three_d = x.shape[0] == 3
     return weight_at(x[0, i], x[1, i], x[2, i] if three_d else 0.0, three_d, box_of(p))
 
 
-@kernel
+@jit.kernel
 def inside_box(x, i, p):
     """True when node i lies inside the box described by ``p`` (its sharp edges, whatever the edge width)."""
     three_d = x.shape[0] == 3
@@ -95,7 +95,7 @@ def inside_box(x, i, p):
     return weight_at(x[0, i], x[1, i], x[2, i] if three_d else 0.0, three_d, sharp) > 0.0
 
 
-@kernel
+@jit.kernel
 def add_thrower(x, v, acc, inv_mass, p, g):
     """Add the box's drive and centring accelerations [m/s^2] to every node inside it."""
     n = x.shape[1]
@@ -128,7 +128,7 @@ def add_thrower(x, v, acc, inv_mass, p, g):
 
 
 
-@kernel
+@jit.kernel
 def add_thrower_jacobian(x, band, beta, mass, free, p):
     """Add the box's node blocks to the stiff integrator's Newton matrix (see :mod:`ropesim.model.jacobian`).
 
