@@ -204,6 +204,32 @@ class ChainCase:
         return sinusoidal_motion(self.fairlead, self.amplitude, self.period, 0, self.ramp_periods)
 
 
+@dataclass(frozen=True)
+class Surge:
+    """A smooth surge of the fairlead, ropesim's ``[[driven]]`` sinusoid: x(t) = x0 + r(t) A sin(2 pi t / T) along
+    x, r(t) = (1 - cos(pi t / ramp_time)) / 2 until ramp_time, then 1. amplitude A (m), period T (s), ramp_time
+    (s)."""
+
+    amplitude: float
+    period: float
+    ramp_time: float
+
+    def motion(self, x0):
+        """The same path as a function t (s) -> MoorDyn position (m), for MoorDyn's coupled fairlead."""
+        x0 = np.asarray(x0, dtype=float)
+
+        def path(t: float) -> np.ndarray:
+            if self.ramp_time <= 0.0 or t >= self.ramp_time:
+                r = 1.0
+            else:
+                r = 0.5 * (1.0 - math.cos(math.pi * max(t, 0.0) / self.ramp_time))
+            x = x0.copy()
+            x[0] += r * self.amplitude * math.sin(2.0 * math.pi * t / self.period)
+            return x
+
+        return path
+
+
 def chain_case(name: str) -> ChainCase:
     """A chain case read from MoorDyn's input file (line, points, seabed, options, MoorDyn 2.7.2's defaults where
     the file is silent) and the stored run's record (its motion and MoorDyn's step)."""
@@ -252,13 +278,14 @@ def path_rows(case: ChainCase, t_end: float | None = None) -> list[list[float]]:
 
 def chain_scene_dict(case: ChainCase, start=None, method: str = "rk4", dt: float | None = None,
                      t_end: float | None = None, moving: bool = True, interval: float | None = None,
-                     friction: bool = True, dimension: int = 2) -> dict:
+                     friction: bool = True, dimension: int = 2, surge: Surge | None = None) -> dict:
     """ropesim's scene (a TOML-ready dict) for a chain case.
 
     start: MoorDyn node positions (N+1, 3) as an ``initial.shape = "points"`` start at rest, or None for
     ropesim's own static shape (``initial.shape = "equilibrium"``); moving: the fairlead follows the stored path
-    (:func:`path_rows`) until t_end, else it is pinned at rest; friction: MoorDyn's (see the module docstring)
-    or none; dimension: 2 (the x-z plane) or 3 (MoorDyn's (x, y, z) as ropesim's (x, z, y))."""
+    (:func:`path_rows`) until t_end, or with ``surge`` that smooth surge (ropesim's own sinusoid, exact at every
+    stage), else it is pinned at rest; friction: MoorDyn's (see the module docstring) or none; dimension: 2 (the
+    x-z plane) or 3 (MoorDyn's (x, y, z) as ropesim's (x, z, y))."""
     if dimension == 2:
         conv = to_ropesim
     else:
@@ -287,7 +314,10 @@ def chain_scene_dict(case: ChainCase, start=None, method: str = "rk4", dt: float
                    "friction": case.friction if friction else 0.0, "friction_speed": case.friction_speed},
         "pinned": {"nodes": [0] if moving else [0, -1]},
     }
-    if moving:
+    if moving and surge is not None:
+        scene["driven"] = [{"nodes": [-1], "amplitude": [surge.amplitude] + [0.0] * (dimension - 1),
+                            "period": [surge.period] * dimension, "ramp_time": surge.ramp_time}]
+    elif moving:
         rows = path_rows(case, t_end)
         if dimension == 3:
             rows = [[t, dx, dy, 0.0] for t, dx, dy in rows]
@@ -627,16 +657,40 @@ def _find_block(values: np.ndarray, block: np.ndarray) -> int:
     return int(hits[0])
 
 
+def set_line_state(md, system, line, positions) -> None:
+    """Put a MoorDyn line's nodes at ``positions`` (N+1, 3) (MoorDyn frame, m), at rest, before its first step.
+
+    MoorDyn has no call for it, so its serialized state (``Serialize``) is edited: it holds the inner nodes'
+    positions and velocities (the time integrator's state, (r, v) per node) and every node's position (the line's
+    own), each found exactly once by value (the line must be at rest, as after ``Init_NoIC``); both are overwritten
+    and loaded back (``Deserialize``), and the positions read back to check. The end nodes must already be where
+    ``positions`` puts them (they follow their points)."""
+    from .moordyn_harness import quiet_fd
+
+    positions = np.asarray(positions, dtype=float)
+    n = positions.shape[0] - 1
+    now = np.array([md.GetLineNodePos(line, i) for i in range(n + 1)])
+    if np.abs(now[[0, -1]] - positions[[0, -1]]).max() > 1e-9:
+        raise ValueError("the line's ends are not where the new state puts them")
+    state = np.frombuffer(md.Serialize(system), dtype=np.float64).copy()
+    inner = np.column_stack([now[1:n], np.zeros((n - 1, 3))]).ravel()   # (r, v) of nodes 1..N-1
+    i_inner, i_all = _find_block(state, inner), _find_block(state, now.ravel())
+    state[i_inner:i_inner + inner.size] = np.column_stack([positions[1:n], np.zeros((n - 1, 3))]).ravel()
+    state[i_all:i_all + now.size] = positions.ravel()
+    with quiet_fd():
+        md.Deserialize(system, state.tobytes())
+    back = np.array([md.GetLineNodePos(line, i) for i in range(n + 1)])
+    if np.abs(back - positions).max() > 1e-12:
+        raise RuntimeError("MoorDyn did not take the new state")
+
+
 def run_moordyn_beam_straight(case: BeamCase, t_end: float | None = None, dt_out: float | None = None) -> dict:
     """MoorDyn's BeamCantilevered released straight and at rest, as ropesim's ``initial.shape = "line"`` starts.
 
     MoorDyn itself starts a line on its catenary between the end points (``Init_NoIC``): here a sag of 6.7 cm, its
     first segment 1.5 degrees off the rod's axis, so the clamp starts bent. ropesim's clamp keeps the end
     segment's *initial* direction, which would be that bent one; so instead MoorDyn's state is set straight before
-    its first step: its serialized state (``Serialize``) holds the inner nodes' positions and velocities (the time
-    integrator's state) and every node's position (the line's own), each found exactly once by value; both are
-    overwritten with the straight line at rest and loaded back (``Deserialize``), and checked by reading the
-    positions back. Returns {"t" (F,), "positions" (F, N+1, 3), "wall"} (SI units)."""
+    its first step (:func:`set_line_state`). Returns {"t" (F,), "positions" (F, N+1, 3), "wall"} (SI units)."""
     from .moordyn_harness import QUIET_OPTIONS, moordyn_system, quiet_fd, set_options
 
     t_end = case.t_end if t_end is None else t_end
@@ -646,18 +700,9 @@ def run_moordyn_beam_straight(case: BeamCase, t_end: float | None = None, dt_out
     straight = np.asarray(case.clamp) + np.outer(np.linspace(0.0, case.length, n + 1), case.axis)
     with moordyn_system(text, None, ic=False) as (md, system):
         line = md.GetLine(system, 1)
-        start = np.array([md.GetLineNodePos(line, i) for i in range(n + 1)])
-        state = np.frombuffer(md.Serialize(system), dtype=np.float64).copy()
-        inner = np.column_stack([start[1:n], np.zeros((n - 1, 3))]).ravel()   # (r, v) of nodes 1..N-1
-        i_inner, i_all = _find_block(state, inner), _find_block(state, start.ravel())
-        state[i_inner:i_inner + inner.size] = np.column_stack([straight[1:n], np.zeros((n - 1, 3))]).ravel()
-        state[i_all:i_all + start.size] = straight.ravel()
-        with quiet_fd():
-            md.Deserialize(system, state.tobytes())
+        set_line_state(md, system, line, straight)
         steps = int(round(t_end / dt_out))
         frames = [np.array([md.GetLineNodePos(line, i) for i in range(n + 1)])]
-        if np.abs(frames[0] - straight).max() > 1e-12:
-            raise RuntimeError("MoorDyn did not take the straight start")
         wall, t = 0.0, 0.0
         with quiet_fd():
             for k in range(steps):
@@ -667,3 +712,53 @@ def run_moordyn_beam_straight(case: BeamCase, t_end: float | None = None, dt_out
                 t = dt_out * (k + 1)
                 frames.append(np.array([md.GetLineNodePos(line, i) for i in range(n + 1)]))
     return {"t": dt_out * np.arange(steps + 1), "positions": np.array(frames), "wall": wall}
+
+
+def moordyn_line_text(case: ChainCase, dtM: float, scheme: str = "RK2") -> str:
+    """A MoorDyn input file for a chain case's line as ``moordyn_harness.line_input_text`` writes it (anchor fixed,
+    fairlead coupled, the case's line type, seabed, friction, water and g), with the case's own EA and BA (so a
+    case changed with ``with_`` runs as changed), no IC options needed (see :func:`run_moordyn_line`)."""
+    from .moordyn_harness import Environment, LineProps, Solver, line_input_text
+
+    line = LineProps(case.length, case.segments, case.diameter, case.mass_per_length, case.EA, case.BA, 0.0,
+                     case.Cd, case.Ca, case.CdAx, case.CaAx)
+    env = Environment(case.depth, case.g, case.rho_w, case.kbot, case.cbot, case.friction, case.fric_damp, 1.0)
+    return line_input_text(line, env, case.anchor, case.fairlead, Solver(dtM=dtM, scheme=scheme, ic=False))
+
+
+def run_moordyn_line(case: ChainCase, start, motion, dtM: float, scheme: str, t_end: float,
+                     coupling: float | None = None, dt_out: float = 0.1) -> dict:
+    """MoorDyn on a chain case's line from ``start`` (MoorDyn node positions (N+1, 3), at rest; set with
+    :func:`set_line_state`, no IC), the fairlead following ``motion`` (t -> MoorDyn position), handed to MoorDyn
+    every ``coupling`` seconds (default dtM: one internal step per ``Step``, so its fairlead's piecewise-linear path
+    follows the motion as closely as MoorDyn can) as the harness does. Returns {"t" (F,), "fairlead" (F,): its
+    reported ``GetLineFairTen`` every dt_out, "wall": the Step calls' wall time (s), "calls", "ok": False if a
+    tension came out non-finite}."""
+    from .moordyn_harness import moordyn_system, quiet_fd
+
+    coupling = dtM if coupling is None else coupling
+    every = int(round(dt_out / coupling))
+    steps = int(round(t_end / coupling))
+    if abs(every * coupling - dt_out) > 1e-12 or abs(steps * coupling - t_end) > 1e-9:
+        raise ValueError("the coupling step must divide dt_out and t_end")
+    out, wall, ok = [], 0.0, True
+    with moordyn_system(moordyn_line_text(case, dtM, scheme), motion(0.0), ic=False) as (md, system):
+        line = md.GetLine(system, 1)
+        set_line_state(md, system, line, start)
+        out.append(md.GetLineFairTen(line))
+        with quiet_fd():
+            xa = np.asarray(motion(0.0), dtype=float)
+            for k in range(steps):
+                xb = np.asarray(motion(coupling * (k + 1)), dtype=float)
+                x, v = list(xa), list((xb - xa) / coupling)
+                tic = _clock()
+                forces = md.Step(system, x, v, coupling * k, coupling)
+                wall += _clock() - tic
+                xa = xb
+                if (k + 1) % every == 0:
+                    tension = md.GetLineFairTen(line)
+                    out.append(tension)
+                    if forces is None or not np.all(np.isfinite(forces)) or not tension < 1e12:
+                        ok = False
+                        break
+    return {"t": dt_out * np.arange(len(out)), "fairlead": np.array(out), "wall": wall, "calls": steps, "ok": ok}
