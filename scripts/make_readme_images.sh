@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerate the docs' pictures of the built-in scenarios (docs/images/scenarios/) with ropesim's own
 # commands: the towed ropes as overlaid frames seen from the helicopter, run long enough to reach their steady
-# shapes (plus the plot of the one with the end mass), the string shooters as small GIFs of their default runs.
+# shapes (plus the plot of the one with the end mass), the string shooters as small GIFs of their default runs
+# (the real one, string_shooter_real, slowed down, with a frame sheet).
 #
 #     scripts/make_readme_images.sh        # about a minute on two cores; prints the pictures' total size
 set -euo pipefail
@@ -30,4 +31,10 @@ for scene in shooter_vacuum shooter_low shooter_low_one_sided shooter_medium sho
     ropesim run "scenarios/$scene.toml" -o "$runs/$scene" -q
     ropesim animate "$runs/$scene" --fps 10 --size 320 -o "$out/$scene.gif" -q
 done
+# the real string shooter: 25 m/s, so slowed down four times over its first 1.5 s, and a frame sheet to 3 s
+ropesim run string_shooter_real -o "$runs/string_shooter_real" -q
+ropesim animate "$runs/string_shooter_real" --fps 20 --speed 0.25 --end 1.5 --size 320 \
+    -o "$out/string_shooter_real.gif" -q
+ropesim frames "$runs/string_shooter_real" --times 0,0.03,0.06,0.1,0.2,0.5,1,3 --columns 4 --width 760 \
+    -o "$out/string_shooter_real_frames.png" -q
 du -ch "$out"/* | tail -1

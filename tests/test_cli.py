@@ -27,9 +27,9 @@ from ropesim.scene.loader import load_scene
 
 from conftest import ROOT, SCENARIOS
 
-T_END, DT, INTERVAL = 0.05, 0.001, 0.01  # every scene is run for 50 ms at dt = 1 ms, saving every 10 ms
+T_END, DT, INTERVAL = 0.05, 0.001, 0.01  # every scene is run for 50 ms, saving every 10 ms; most step 1 ms
 SHORT = f"integrator.t_end={T_END}"
-SHORT_RUN = (SHORT, f"integrator.dt={DT}", f"output.interval={INTERVAL}")
+SHORT_RUN = (SHORT, f"output.interval={INTERVAL}")   # each scene keeps its own dt
 SCENES = sorted(p.stem for p in SCENARIOS.glob("*.toml"))
 ENV = {"COLUMNS": "200"}  # wide rich tables, so printed figures are not wrapped
 TIMING_KEYS = {"wall_time_s", "compile_time_s", "steps_per_second", "node_steps_per_second"}
@@ -124,8 +124,9 @@ def test_summary_figures_agree_with_the_trajectory(runs, name):
     s = read_summary(folder)
 
     assert s["scene"] == name and s["status"] == "completed" and s["method"] == scene.integrator.method
-    assert s["t_end"] == pytest.approx(T_END, abs=1e-15) and s["dt"] == pytest.approx(DT, rel=1e-12)
-    assert s["steps"] == round(T_END / DT) and s["frames"] == len(arrays["t"]) and s["nodes"] == scene.rope.nodes
+    dt = scene.integrator.dt   # 1 ms, but 20 us for string_shooter_real's light, stiff string
+    assert s["t_end"] == pytest.approx(T_END, abs=1e-15) and s["dt"] == pytest.approx(dt, rel=1e-12)
+    assert s["steps"] == round(T_END / dt) and s["frames"] == len(arrays["t"]) and s["nodes"] == scene.rope.nodes
     assert "dt_requested" not in s
     assert s["wall_time_s"] >= 0 and s["compile_time_s"] >= 0
     wall, rate = s["wall_time_s"], s["steps_per_second"]

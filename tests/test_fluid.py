@@ -313,6 +313,76 @@ def test_a_neutrally_buoyant_rope_stays_put(method):
     assert np.abs(traj.x[-1] - traj.x[0]).max() < 1e-12 and np.abs(traj.v).max() < 1e-12
 
 
+ACCELERATING = """
+dimension = 3
+[rope]
+length = 2.0
+segments = 4
+diameter = 0.05
+density = 2050.0
+EA = 1e5
+[initial]
+shape = "line"
+start = [0.0, 0.0, 0.0]
+end = [1.0, 1.0, 0.0]
+[integrator]
+method = "rk4"
+dt = 1e-3
+t_end = 3.0
+[output]
+interval = 0.1
+[gravity]
+g = 9.81
+[fluid]
+density = 1025.0
+[flow]
+velocity = [1.0, 0.0, 0.5]
+ramp_time = 3.0
+[added_mass]
+ca_normal = 1.0
+ca_tangential = 0.3
+"""
+
+
+@pytest.mark.parametrize("buoyancy", [True, False])
+def test_a_rope_in_accelerating_water_follows_morisons_inertia_term(buoyancy):
+    """A straight free rope twice as dense as the water, no drag, in a flow ramping in, U r(t): every node has the
+    same mass, volume and added mass per length, so the rope translates rigidly and each node's velocity is, split
+    along the rope's direction q (normal n, tangential t),
+
+        v(t) = sum over n, t of P [(rho V b - m) g t y + (b + Ca) rho V U r(t)] / (m + Ca rho V),
+
+    b = 1 with [buoyancy] (its weight's share and the pressure gradient rho V dU/dt), 0 without (the added
+    mass's part alone). rk4 integrates this to round-off."""
+    scene = ropesim.scene_from_toml(ACCELERATING + ("[buoyancy]\n" if buoyancy else ""))
+    traj = ropesim.simulate(scene)
+    t = np.asarray(traj.t)
+    b, rho, g = (1.0 if buoyancy else 0.0), 1025.0, 9.81
+    q = np.array([1.0, 1.0, 0.0]) / math.sqrt(2.0)
+    along, normal = np.outer(q, q), np.eye(3) - np.outer(q, q)
+    ramp = 0.5 * (1.0 - np.cos(np.pi * t / 3.0))
+    expected = np.zeros((len(t), 3))
+    for proj, ca in ((normal, 1.0), (along, 0.3)):   # per unit volume: m = 2 rho, Ca rho, (b + Ca) rho
+        push = np.outer(t, (b * rho - 2.0 * rho) * g * np.array([0.0, 1.0, 0.0])) + np.outer(
+            ramp, (b + ca) * rho * np.array([1.0, 0.0, 0.5]))
+        expected += push @ proj.T / (2.0 * rho + ca * rho)
+    np.testing.assert_allclose(traj.v, np.broadcast_to(expected[:, None, :], traj.v.shape), rtol=0, atol=1e-11)
+    ledger = traj.summary["energy_ledger"]   # the fluid's work (the push, the added mass against the sinking)
+    assert ledger["relative_residual"] < 1e-12 and ledger["fluid_work_J"] != 0.0   # closes the balance
+
+
+def test_the_water_pushes_only_while_it_accelerates():
+    """After the ramp (and in a steady flow) the inertia term is zero: the same rope keeps the velocity it had at
+    the ramp's end, its sinking aside."""
+    scene = ropesim.scene_from_toml(ACCELERATING + "[buoyancy]\n", overrides=["integrator.t_end=5.0",
+                                                                               "gravity.g=0.0"])
+    traj = ropesim.simulate(scene)
+    after = np.asarray(traj.t) >= 3.0
+    np.testing.assert_allclose(traj.v[after], np.broadcast_to(traj.v[np.argmax(after)], traj.v[after].shape),
+                               rtol=0, atol=1e-13)
+    assert np.abs(traj.v[np.argmax(after)]).max() > 0.5
+
+
 # ----------------------------------------------------------------------------------------- the numerics
 
 FLUID_ORDER = """

@@ -690,3 +690,29 @@ toml_lines = st.one_of(
 @given(st.lists(toml_lines, max_size=12))
 def test_random_toml_ish_text_never_crashes(lines):
     _accepted_or_one_line("\n".join(lines))
+
+
+def test_a_scene_error_survives_pickling():
+    """A sweep's worker process raises it in another process: the message must arrive whole."""
+    import pickle
+
+    error = SceneError("a.toml", "rope.mass", "must be a number > 0, got -1")
+    again = pickle.loads(pickle.dumps(error))
+    assert isinstance(again, SceneError) and str(again) == str(error) == "a.toml: rope.mass: must be a number > 0, got -1"
+    assert (again.source, again.key, again.message) == (error.source, error.key, error.message)
+
+
+@pytest.mark.parametrize("rope, key, fragment", [
+    ({"length": 2e-12, "segments": 40, "mass_per_length": 0.13, "EA": 1e-3}, "rope.length",
+     "gives segment_length = length / segments = 5e-14 [m], outside 1e-12"),
+    ({"length": 2e-8, "segments": 40, "mass_per_length": 0.13, "EA": 5e6}, "rope.EA",
+     "gives stiffness = EA / l = 1e+16 [N/m]"),
+    ({"length": 20.0, "segments": 40, "mass_per_length": 0.13, "EA": 1e12}, "rope.EA",
+     "gives stiffness = EA / l = 2e+12 [N/m], outside 1e-12 to 1e+12"),
+    ({"length": 20.0, "segments": 40, "mass_per_length": 1e-12, "EA": 5e6}, "rope.mass_per_length",
+     "gives mass = mass_per_length x l = 5e-13 [kg]"),
+])
+def test_a_physical_rope_whose_per_node_values_would_overflow_is_refused(rope, key, fragment):
+    """The per-node values derived from the physical form obey the per-node keys' limits, so a resolved scene
+    always loads again."""
+    refused(variant(LINE, rope=rope), key, fragment)

@@ -6,6 +6,9 @@
 - Memory: a run folder's frames stream to disk, so the memory a run allocates does not grow with the
   number of saved frames (counted with tracemalloc, which sees NumPy's allocations).
 - Parallel kernels give bit-identical results to the serial ones.
+- The kernels count no references: every compiled function of the model and the integrators is a
+  ``ropesim.model.jit.kernel`` (Numba's ``_nrt=False``), and the compiled term list holds no reference-count
+  call (see ropesim/model/jit.py for why this matters: it was most of a small rope's step).
 """
 
 from __future__ import annotations
@@ -114,6 +117,57 @@ ropesim.simulate(scene)
 stats = advance.stats
 print(json.dumps({"hits": sum(stats.cache_hits.values()), "misses": sum(stats.cache_misses.values())}))
 """
+
+
+def _compiled_functions():
+    """Every Numba dispatcher defined in ropesim.model and ropesim.integrate: (module.name, dispatcher)."""
+    import importlib
+    import pkgutil
+
+    from numba.core.registry import CPUDispatcher
+
+    found = []
+    for package in ("ropesim.model", "ropesim.model.forces", "ropesim.integrate"):
+        pkg = importlib.import_module(package)
+        for info in pkgutil.iter_modules(pkg.__path__):
+            module = importlib.import_module(f"{package}.{info.name}")
+            for name, value in vars(module).items():
+                if isinstance(value, CPUDispatcher) and value.py_func.__module__ == module.__name__:
+                    found.append((f"{module.__name__}.{name}", value))
+    return found
+
+
+def test_every_kernel_is_compiled_without_reference_counting():
+    found = _compiled_functions()
+    assert len(found) > 60   # the force terms, the term list, the integrators, the banded solver, ...
+    counting = [name for name, fn in found if fn.targetoptions.get("_nrt", True)]
+    assert counting == []
+
+
+@pytest.mark.slow
+def test_the_compiled_term_list_holds_no_reference_count_call(tmp_path):
+    """Compiled fresh in a subprocess (a function loaded from Numba's cache cannot be inspected): the LLVM IR of
+    the term list and the RK4 loop, as one module each, calls neither NRT_incref nor NRT_decref."""
+    probe = (
+        "import re, ropesim\n"
+        "from ropesim.model.build import build\n"
+        "from ropesim.integrate.grid import TimeGrid\n"
+        "from ropesim.integrate.methods import make_integrator\n"
+        "from ropesim.integrate import rk\n"
+        "from ropesim.model import terms\n"
+        "scene = ropesim.load_scene('helicopter_crosswind', ['integrator.method=rk4'])\n"
+        "it = make_integrator(build(scene), TimeGrid.of(scene), 'rk4'); it.warm_up()\n"
+        "for fn in (terms.accelerations, rk.advance_rk):\n"
+        "    ir = list(fn.inspect_llvm().values())[0]\n"
+        "    own = [m.group(0) for m in re.finditer(r'define [^\\n]*ropesim[^\\n]*\\{.*?\\n\\}', ir, re.S)\n"
+        "           if 'cpython' not in m.group(0).split('(')[0]]\n"
+        "    print(fn.__name__, len(own), sum(body.count('@NRT_incref') + body.count('@NRT_decref') for body in own))\n")
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=env, check=True).stdout
+    counts = {name: (int(functions), int(calls)) for name, functions, calls in (line.split() for line in
+                                                                               out.splitlines())}
+    assert counts["accelerations"][0] >= 5 and counts["advance_rk"][0] >= 10   # the functions were found
+    assert counts == {name: (functions, 0) for name, (functions, _) in counts.items()}
 
 
 def test_a_compiled_kernel_loads_from_the_cache_in_a_fresh_process(scenarios):

@@ -140,7 +140,7 @@ def test_check_prints_both_bounds_for_every_method():
     assert "Gershgorin bound 160 rad/s" in out and "omega_max <= 153.6 rad/s" in out
     for name in METHODS:
         assert f"  {name}" in out
-    assert "stable at any dt" in out and "explicit damping" in out
+    assert "stable at any dt" in out and "velocity damping" in out
 
 
 def test_run_warns_above_80_percent_and_refuses_above_the_bound(tmp_path):

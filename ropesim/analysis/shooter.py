@@ -1,8 +1,12 @@
-"""The string shooter's loop: its inclination and how fast the string goes round.
+"""The string shooter's loop: its inclination, its height and how fast the string goes round.
 
 Inclination is the direction of the loop's centroid seen from the thrower's centre, measured from straight
 down, positive towards the throw (+x): 0 degrees is a loop hanging vertically below the thrower (the vacuum
-picture), 90 degrees a loop standing straight out in front of it (the in-air picture).
+picture), 90 degrees a loop standing straight out in front of it (the in-air picture), above 90 a loop lifted
+above the thrower. It is measured from the vertical whatever the thrower's launch angle (``thrower.angle``, at
+most 90 degrees either way, so the throw always goes towards +x): hanging and lifted are about gravity, and
+loops thrown at different angles compare directly. The centroid's height above the thrower's centre [m] says
+the same in length units (negative: the loop hangs below the wheels).
 """
 
 from __future__ import annotations
@@ -21,6 +25,11 @@ def loop_inclination(model: Model, x: np.ndarray) -> np.ndarray:
     return np.degrees(np.arctan2(d[..., 0], -d[..., 1]))
 
 
+def centroid_height(model: Model, x: np.ndarray) -> np.ndarray:
+    """Height [m] of the loop's centroid above the thrower's centre for one frame (N, D) or many (F, N, D)."""
+    return np.asarray(x)[..., :, 1].mean(axis=-1) - model.scene.thrower.center[1]
+
+
 def circulation_speed(x: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Mean speed [m/s] of the string along itself (positive from node i towards node i+1), per frame."""
     x, v = np.asarray(x), np.asarray(v)
@@ -31,13 +40,17 @@ def circulation_speed(x: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 
 def shooter_figures(model: Model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> dict:
-    """The shooter's summary: inclination at the end and averaged at the end, and the circulation speed."""
+    """The shooter's summary: inclination and centroid height at the end and averaged at the end, and the
+    circulation speed."""
     window = min(AVERAGE_WINDOW_S, 0.2 * float(t[-1]))
     last = np.flatnonzero(t >= t[-1] - window)
     incl = loop_inclination(model, x[last])
+    height = centroid_height(model, x[last])
     return {
         "loop_inclination_deg": round(float(incl[-1]), 3),
         "mean_loop_inclination_deg": round(float(incl.mean()), 3),
+        "centroid_height_m": round(float(height[-1]), 6),
+        "mean_centroid_height_m": round(float(height.mean()), 6),
         "averaged_over_s": round(float(t[-1] - t[last[0]]), 6),
         "circulation_speed_m_s": round(float(circulation_speed(x[-1], v[-1])), 4),
         "drive_speed_m_s": model.scene.thrower.v_max,

@@ -42,7 +42,16 @@ class _CleanHelp:
 
 
 class Command(_CleanHelp, TyperCommand):
-    pass
+    def invoke(self, ctx):
+        """A scene whose ``equilibrium`` start cannot be solved stops any command that builds it: one line,
+        exit 1 (the scene is valid; its static shape could not be found)."""
+        from ..model.build import EquilibriumError
+
+        try:
+            return super().invoke(ctx)
+        except EquilibriumError as exc:
+            typer.echo(f"ropesim: {exc}", err=True)
+            raise typer.Exit(1) from None
 
 
 class Group(_CleanHelp, TyperGroup):
@@ -285,6 +294,47 @@ def check(scene_file: SceneArg, sets: SetOpt = None) -> None:
     elif est.bytes > WARN_BYTES or est.seconds > WARN_SECONDS:
         typer.echo(f"ropesim: warning: {where}: a large run (about {human(est.bytes)}, {_duration(est.seconds)})",
                    err=True)
+
+
+@app.command(cls=Command)
+def equilibrium(
+    scene_file: SceneArg,
+    sets: SetOpt = None,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", "-o", metavar="FILE.toml", help="Also write the scene with its static shape as a 'points' start "
+                                                  "(every node at rest), to run or to edit.",
+        show_default=False)] = None,
+    force: Annotated[bool, typer.Option("--force", help="Replace FILE.toml if it exists.")] = False,
+) -> None:
+    """Find a scene's static shape: every force balanced at every free node, the held nodes where the scene holds
+    them; print the support forces, the tensions and what rests on the seabed.
+
+    The solve starts from the scene's initial shape (an 'equilibrium' start from its sagging guess) and balances
+    weight, buoyancy, the springs, bending, the seabed's contact and drag in the flow at its full strength. A
+    scene with initial.shape = "equilibrium" starts its runs from this shape. Exit 1 if it does not converge.
+    """
+    from .report import print_equilibrium
+    from ..analysis.statics import as_points_scene, equilibrium as solve
+    from ..io.trajectory import write_text_atomic
+    from ..scene.schema import scene_to_toml
+
+    scene, where = _load(scene_file, sets)
+    if out is not None:
+        if out.suffix != ".toml":
+            fail(f"--out {out}: must name a .toml file")
+        if out.exists() and not force:
+            fail(f"--out {out}: exists; choose another file or add --force to replace it")
+    shape = solve(scene)
+    print_equilibrium(shape, where)
+    if not shape.converged:
+        fail(f"{where}: the static solve did not converge (largest residual force {shape.residual:.3g} N after "
+             f"{shape.iterations} iterations); check that the rope can hang where the scene holds it", 1)
+    if out is not None:
+        try:
+            write_text_atomic(out, scene_to_toml(as_points_scene(shape)))
+        except OSError as exc:
+            fail(f"--out {out}: cannot write it ({exc.strerror or exc})", EXIT_WRITE)
+        typer.echo(f"written: {out} (run it with `ropesim run {out}`)")
 
 
 @app.command(cls=Command)

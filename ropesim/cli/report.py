@@ -83,6 +83,9 @@ def print_summary(summary: dict, folder: Path) -> None:
         rows.append(("loop inclination", f"{shooter['loop_inclination_deg']:.1f} deg from vertical at t_end "
                                          f"(mean {shooter['mean_loop_inclination_deg']:.1f} deg over the last "
                                          f"{shooter['averaged_over_s']:.3g} s)"))
+        if "mean_centroid_height_m" in shooter:
+            rows.append(("loop height", f"centroid {shooter['centroid_height_m']:.3g} m above the thrower's centre "
+                                        f"at t_end (mean {shooter['mean_centroid_height_m']:.3g} m)"))
     tension = summary.get("tension")
     if tension:
         rows.append(("tension", f"{tension['start_N']:.4g} N at node 0's end, {tension['end_N']:.4g} N at the "
@@ -143,7 +146,8 @@ def print_check(scene: Scene, source: Path) -> None:
     if model.has_drag:
         terms.append(f"drag (b = {scene.drag.b if scene.drag else 0:g} kg/s)")
     if scene.thrower:
-        terms.append(f"thrower (v_max = {scene.thrower.v_max:g} m/s)")
+        angle = f", launch angle {scene.thrower.angle:g} deg" if scene.thrower.angle else ""
+        terms.append(f"thrower (v_max = {scene.thrower.v_max:g} m/s{angle})")
     if scene.guides:
         terms.append(f"{len(scene.guides)} guide circle{'s' if len(scene.guides) > 1 else ''}")
     if rope.axial_damping:
@@ -192,15 +196,19 @@ def stability_rows(model, method: str, dt: float) -> list[tuple[str, str]]:
         return [("fastest mode", "no free node: nothing to integrate")]
     out = [("fastest mode", f"omega_max <= {s:.4g} rad/s (largest eigenvalue of the mass-weighted spring "
                             f"stiffness); Gershgorin bound {g:.4g} rad/s")]
+    scene = model.scene
     damping = explicit_damping(model)
     if damping > 0:
-        out.append(("explicit damping", f"{damping:.4g} 1/s (thrower and guides' velocity terms, evaluated "
-                                        f"explicitly: they shorten the explicit methods' steps)"))
+        from ..model.terms import declared_terms
+
+        rates = {term.name: term.damping(model) for term in declared_terms(scene)}
+        names = ", ".join(name for name, rate in rates.items() if rate > 0)
+        out.append(("velocity damping", f"up to {damping:.4g} 1/s ({names}); the bounds below include it where "
+                                        f"a method evaluates it explicitly"))
     high = drag_rates(model)[1]
     if high > 0:
         out.append(("drag", f"b/m up to {high:.4g} 1/s: exact in the splitting schemes' kicks, explicit in rk4, "
                             f"implicit in sdirk2"))
-    scene = model.scene
     sharp = [name for name, part in (("thrower", scene.thrower), *(("guides", g) for g in scene.guides))
              if part is not None and part.edge_width == 0]
     if sharp:
@@ -274,3 +282,47 @@ def print_stability(result, folder: Path) -> None:
     if unstable:
         console.print(f"sdirk2 failed {len(unstable)} probes (Newton did not converge or the energy balance broke)")
     console.print(f"written: {folder}/ (stability.csv, bounds.csv, stability.png)")
+
+
+def print_equilibrium(shape, source: str) -> None:
+    """The static shape's figures (:class:`ropesim.analysis.statics.StaticShape`) as one table."""
+    import numpy as np
+
+    model, x = shape.model, shape.x
+    scene = model.scene
+    verdict = (f"static shape found in {shape.iterations} iterations" if shape.converged
+               else f"NOT converged after {shape.iterations} iterations")
+    table = Table(title=f"{source}: {verdict}", show_header=False, title_justify="left")
+    table.add_column("", style="bold")
+    table.add_column("", overflow="fold")
+    table.add_row("residual", f"largest force left on a free node {shape.residual:.3g} N "
+                              f"({shape.residual / shape.scale:.2g} of the largest force a term puts on a node, "
+                              f"{shape.scale:.4g} N)")
+    axes = "xyz"[:model.dim]
+    for node, force in zip(shape.held, shape.supports):
+        kind = "pinned" if scene.pinned and node in {scene.node(i) for i in scene.pinned.nodes} else "driven"
+        parts = ", ".join(f"F{a} = {f:.6g}" for a, f in zip(axes, force))
+        table.add_row(f"support, node {node}", f"{kind} at {_point(x[node])} m: {parts} N, "
+                                               f"|F| = {float(np.linalg.norm(force)):.6g} N")
+    tension = shape.tension
+    if tension.size:
+        k = int(np.argmax(tension))
+        slack = int(np.count_nonzero(tension <= 0.0))
+        table.add_row("tension", f"first segment {tension[0]:.6g} N, last segment {tension[-1]:.6g} N, largest "
+                                 f"{tension[k]:.6g} N in segment {k}" + (f"; {slack} slack" if slack else ""))
+    if scene.seabed is not None:
+        if shape.grounded.size:
+            where = (f"; touchdown at node {shape.touchdown}, {_point(x[shape.touchdown])} m"
+                     if shape.touchdown is not None else "")
+            table.add_row("seabed", f"{shape.grounded.size} nodes rest on it, carrying {shape.grounded_length:.6g} "
+                                    f"m of rope{where}")
+        else:
+            table.add_row("seabed", "no node touches it")
+    span = x[-1] - x[0]
+    table.add_row("ends", f"node 0 at {_point(x[0])} m, the last node "
+                          f"{', '.join(f'{a} {d:+.6g}' for a, d in zip(axes, span))} m from it")
+    _console().print(table)
+
+
+def _point(p) -> str:
+    return "(" + ", ".join(f"{float(c):.6g}" for c in p) + ")"

@@ -4,8 +4,9 @@ The box's and guides' forces are linear in velocity: inside the box a_x = (b_thr
 a_y = ... - 2 zeta omega0 v_y, in a circle a_r = ... - 2 zeta omega0 v_r. Evaluated at the velocity a kick starts
 from, as a plain kick does, they make the kick an explicit Euler step of v' = a(x, v), and every splitting
 scheme drops to first order on the shooter. But with x frozen, as it is during a kick, the kick's equation is
-linear, v' = b - A v, with A = gamma_drag I + Gamma(x) (Gamma: the box's diag(s b_thrower / m, s c, s c) plus
-each circle's weight times c r_hat r_hat^T) and b = a(x, v0) + Gamma v0, so it is solved exactly:
+linear, v' = b - A v, with A = gamma_drag I + Gamma(x) (Gamma: the box's diag(s b_thrower / m, s c, s c), turned
+with the box when it has a launch angle (s b_thrower / m e e^T + s c n n^T in x-y), plus each circle's weight
+times c r_hat r_hat^T) and b = a(x, v0) + Gamma v0, so it is solved exactly:
 
     v(tau) = e^(-A tau) v0 + A^-1 (I - e^(-A tau)) b,
 
@@ -17,13 +18,13 @@ A one-sided circle's smooth release depends on v_r nonlinearly: it is frozen at 
 
 import math
 
-from numba import njit
 
 from ..model.forces.thrower import box_of, smooth_step, weight_at
 from ..model.terms import GUIDES, THROWER
+from ..model.jit import kernel
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def _phi(lam, tau):
     """(1 - e^(-lam tau)) / lam, and tau at lam = 0."""
     z = lam * tau
@@ -32,7 +33,7 @@ def _phi(lam, tau):
     return -math.expm1(-z) / lam
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def exact_contact_kicks(x, v, acc, out, nodes, tau, gamma, free, forces):
     """For every free node the box or a circle touches, its velocity after an exact kick of length ``tau``
     into ``out[:, i]``, its index into ``nodes``; returns how many. ``acc`` is a(x, v) without drag and
@@ -41,6 +42,8 @@ def exact_contact_kicks(x, v, acc, out, nodes, tau, gamma, free, forces):
     dim, n = x.shape
     three_d = dim == 3
     box = box_of(thrower)
+    ca, sa = thrower[10], thrower[11]
+    rotated = not (sa == 0.0 and ca == 1.0)
     count = 0
     for i in range(n):
         if not free[i]:
@@ -51,9 +54,16 @@ def exact_contact_kicks(x, v, acc, out, nodes, tau, gamma, free, forces):
             s = weight_at(x[0, i], x[1, i], x[2, i] if three_d else 0.0, three_d, box)
             outside = 1.0 - s
             if s > 0.0:
-                gxx += s * thrower[6] * inv_mass[i]
-                gyy += s * thrower[8]
-                gzz += s * thrower[8]
+                if rotated:     # the drive's rate along e = (ca, sa), the centring's across it
+                    drive, centring = s * thrower[6] * inv_mass[i], s * thrower[8]
+                    gxx += drive * ca * ca + centring * sa * sa
+                    gxy += (drive - centring) * ca * sa
+                    gyy += drive * sa * sa + centring * ca * ca
+                    gzz += centring
+                else:
+                    gxx += s * thrower[6] * inv_mass[i]
+                    gyy += s * thrower[8]
+                    gzz += s * thrower[8]
         if flags[GUIDES] and outside > 0.0:
             for c in range(guides.shape[0]):
                 dx = x[0, i] - guides[c, 0]

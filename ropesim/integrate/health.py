@@ -21,8 +21,8 @@ positive) and of the seabed W_seabed; then the initial mechanical energy E0 and 
 """
 
 import numpy as np
-from numba import njit
 
+from ..model.jit import kernel
 from ..model.motion import place_moving
 from ..model.terms import mechanical_energy
 
@@ -36,7 +36,7 @@ LEDGER_COLUMNS = ("drag_loss", "held_work", "box_work", "fluid_work", "internal_
 """What each saved frame records of the ledger, cumulative [J] (the first LEDGER_COLUMNS entries)."""
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def place_held(x, held_idx, held_x0, held_v, t):
     """Put every held node exactly at x0 + V t."""
     dim = x.shape[0]
@@ -46,7 +46,7 @@ def place_held(x, held_idx, held_x0, held_v, t):
             x[d, i] = held_x0[d, j] + held_v[d, j] * t
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def first_non_finite(x):
     dim, n = x.shape
     for i in range(n):
@@ -56,14 +56,14 @@ def first_non_finite(x):
     return -1
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def check_health(x, v, mass, params, ledger, limits):
     """(status, node): OK and -1 when the state is sane, else the first problem found (see the module doc)."""
     energy, stretch, node = mechanical_energy(x, v, mass, params)
     return verdict(energy, stretch, node, x, v, ledger, limits)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def flows(ledger):
     """(energy that flowed in, net [J]; the sum of the flows' magnitudes [J]) from the ledger."""
     flowed = ledger[HELD] + ledger[BOX] - ledger[DRAG] + ledger[FLUID] + ledger[INTERNAL] + ledger[SEABED]
@@ -72,7 +72,7 @@ def flows(ledger):
     return flowed, moved
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def balance_status(energy, stretch, flowed, moved, e0, scale, max_stretch, of_scale, of_flows):
     """OVERSTRETCH, RUNAWAY_ENERGY or OK from the energy [J], worst stretch and the ledger's flows alone
     (:func:`flows`).
@@ -87,7 +87,7 @@ def balance_status(energy, stretch, flowed, moved, e0, scale, max_stretch, of_sc
     return OK
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def verdict(energy, stretch, node, x, v, ledger, limits):
     """:func:`check_health` given the mechanical energy [J] and the worst stretch (and its node) of the state."""
     if not np.isfinite(energy):   # every position and velocity enters the energy: look for the culprit only now
@@ -114,16 +114,19 @@ def verdict(energy, stretch, node, x, v, ledger, limits):
     return OK, -1
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def save_frame(frame, t, x, v, ledger, frames_t, frames_x, frames_v, frames_w):
     frames_t[frame] = t
-    frames_x[frame] = x
-    frames_v[frame] = v
+    dim, n = x.shape
+    for d in range(dim):   # element by element: a slice assignment may copy its source, which needs an allocation
+        for i in range(n):
+            frames_x[frame, d, i] = x[d, i]
+            frames_v[frame, d, i] = v[d, i]
     for c in range(frames_w.shape[1]):
         frames_w[frame, c] = ledger[c]
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def held_power(acc, mass, held):
     """Power [W] of the held nodes' supports on the rope at one instant.
 
@@ -146,7 +149,7 @@ def held_power(acc, mass, held):
     return p
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def place(x, v, held, t):
     """Put every held node where it must be at time t: x0 + V t, or its prescribed motion (which also sets its
     velocity in ``v``, see :mod:`ropesim.model.motion`)."""
@@ -156,7 +159,7 @@ def place(x, v, held, t):
         place_held(x, held.idx, held.x0, held.v, t)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def power(acc, v, mass):
     """Power [W] of the accelerations ``acc`` on nodes moving at ``v``: sum of m a . v."""
     dim, n = acc.shape
@@ -167,7 +170,7 @@ def power(acc, v, mass):
     return p
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def end_step(done, schedule, x, v, mass, params, ledger, limits, frames, frame):
     """After global step ``done`` (1-based): check the state when due and save a frame when due.
 
@@ -185,7 +188,7 @@ def end_step(done, schedule, x, v, mass, params, ledger, limits, frames, frame):
     return OK, -1, frame
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def due(done, schedule):
     """True when global step ``done`` needs the end-of-step work (a check or a frame)."""
     return done % schedule.check_every == 0 or done % schedule.save_every == 0 or done == schedule.total_steps

@@ -14,13 +14,13 @@ reordering). The loss terms are computed in the same vectorised pass that kicks 
 scratch row, before the sums.
 """
 
-from numba import njit
+from ..model.jit import kernel
 
 LANES = 4   # running sums per reduction
 SCRATCH_NODES = 256   # from this many nodes kick_drift sums each node's loss over the rows before the lanes
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def _add_lanes(t, s0, s1, s2, s3):
     """The four running sums (s0, s1, s2, s3) with ``t`` added: term i to sum i % 4, the tail to s0."""
     n = t.shape[0]
@@ -35,19 +35,19 @@ def _add_lanes(t, s0, s1, s2, s3):
     return s0, s1, s2, s3
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def _lanes(t):
     """Sum of ``t`` as four running sums combined in a fixed order."""
     s0, s1, s2, s3 = _add_lanes(t, 0.0, 0.0, 0.0, 0.0)
     return (s0 + s1) + (s2 + s3)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def _work(vo, a, a_box, gain, travel, m):
     return m * a_box * (gain * vo + travel * a)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def box_work(v, acc, acc_box, gain, travel, k, mass):
     """Work [J] of the accelerations ``acc_box`` (the thrower's and guides') over kick ``k``."""
     dim, n = v.shape
@@ -64,7 +64,7 @@ def box_work(v, acc, acc_box, gain, travel, k, mass):
     return (s0 + s1) + (s2 + s3)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def kick_drift(x, v, acc, decay, gain, travel, k, mass, c, buf):
     """Kick ``k`` and then, when ``c`` != 0, the drift x <- x + c v, in as few passes as the ledger allows.
 

@@ -31,11 +31,11 @@ from __future__ import annotations
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
 
 from ..model.terms import GRAVITY, N_FLAGS
 from .health import DRAG
 from .kick import LANES, _lanes
+from ..model.jit import kernel
 
 BULK_FIXED = 1        # bulk = [1 / m, then per kick stage: decay, gain, reach]
 BULK_PER_STAGE = 3
@@ -94,7 +94,7 @@ def inactive_bundle(stages: int) -> Plain:
                  np.zeros(0), np.zeros(0))
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def settle(lost, v, free_mass, kinetic0, terms):
     """sum_i m_i (lost_i - |v_i|^2 / 2) + kinetic0 over the free nodes (m_i = 0 at held ones), in a fixed order.
 
@@ -106,7 +106,7 @@ def settle(lost, v, free_mass, kinetic0, terms):
     return _lanes(terms) + kinetic0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def chain_energy(x, v, mass, k, rest, closed, g, lengths, terms):
     """(mechanical energy [J], largest spring length / rest length, that spring's first node) of the rope.
 
@@ -147,7 +147,7 @@ def chain_energy(x, v, mass, k, rest, closed, g, lengths, terms):
     return _lanes(terms), worst / rest, node
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def settle_drag(ledger, lost, v, free_mass, kinetic0, has_drag, held_idx, terms):
     """Set ``ledger[DRAG]`` from the work booked in ``lost`` and the kinetic energy the free nodes gained [J].
 

@@ -15,11 +15,11 @@ from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from ..model.terms import ADDED_MASS, accelerations, added_mass, any_applied, applied_accelerations
 from .base import Integrator, Method
 from .health import BOX, DRAG, FLUID, HELD, INTERNAL, OK, SEABED, due, end_step, held_power, place, power
+from ..model.jit import kernel
 
 
 @dataclass(frozen=True)
@@ -98,7 +98,7 @@ class RungeKuttaFamily(Integrator):
                           m.params, self.limits, self.schedule(n), frames)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedule, frames):
     """Advance ``schedule.n_steps`` Runge-Kutta steps in place; the contract of :mod:`ropesim.integrate.base`.
 

@@ -28,7 +28,6 @@ from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from ..model.jacobian import Jacobian, band_width
 from ..model.forces.added_mass import added_mass_times
@@ -37,10 +36,13 @@ from ..model.terms import (ADDED_MASS, accelerations, added_mass, any_applied, a
 from ..model.banded import factor, solve, woodbury
 from .base import Integrator, Method
 from .health import BOX, DRAG, FLUID, HELD, INTERNAL, NEWTON_FAILED, OK, SEABED, due, end_step, held_power, place, power
+from ..model.jit import kernel
 
 GAMMA = 1.0 - 1.0 / math.sqrt(2.0)
 NEWTON_TOL = 1e-11      # Newton stops when no free node's position changes by more than this times l
-NEWTON_MAX_ITER = 40
+NEWTON_MAX_ITER = 60     # residual evaluations per stage, halvings included
+BACKTRACK_ABOVE = 1e3    # halve a step that raised the residual, unless it was within this many tolerances
+MAX_HALVINGS = 8
 
 
 @dataclass(frozen=True)
@@ -83,9 +85,10 @@ SDIRK2 = Sdirk("sdirk2", 2,
                "The stiff integrator: L-stable two-stage SDIRK (Alexander 1977), second order, stable at any "
                "time step; each stage a Newton solve with the rope's banded Jacobian (O(N)), drag implicit.")
 
-Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol"])
+Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol", "step"])
 """The Newton solve's matrix (:class:`~ropesim.model.jacobian.Jacobian`), Woodbury arrays, right-hand side
-(N D,), whether the loop wraps around, and the tolerance [m] on the largest position update."""
+(N D,), whether the loop wraps around, the tolerance [m] on the largest position update, and the last update
+(N D,)."""
 
 Stage = namedtuple("Stage", ["xh", "vh", "X", "V", "acc", "acc_box", "tmp"])
 """A stage's known part (xh, vh), its unknowns (X, V), the accelerations there and scratch, all (D, N)."""
@@ -106,7 +109,8 @@ class SdirkFamily(Integrator):
         w, cyclic = band_width(scene.rope.closed, n, coupling_reach(scene))
         nt, m = dim * n, w * dim
         jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
-        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, NEWTON_TOL * scene.rope.segment_length)
+        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, NEWTON_TOL * scene.rope.segment_length,
+                             np.zeros(nt))
         shape = (dim, n)
         self.stage = Stage(*(np.zeros(shape) for _ in Stage._fields))
         self.nodes = Nodes(np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag))
@@ -122,7 +126,7 @@ class SdirkFamily(Integrator):
                              self.nodes, self.model.params, self.limits, self.schedule(n), frames)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     """Newton solve of one stage: X = xh + beta V, V = vh + beta (a(X, V) - gamma V). Returns
     (iterations, node, fluid power [W], internal-damping power [W]): iterations < 0 when it failed, naming the
@@ -141,6 +145,10 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     worst_node = -1
     inertial = params.flags[ADDED_MASS] != 0
     closed = params.spring[2] != 0.0
+    step = newton.step
+    last = np.inf            # the residual's norm before the last update
+    stride = 0.0             # the last update's largest component [m]
+    halvings = 0
     for it in range(NEWTON_MAX_ITER):
         for d in range(dim):
             for i in range(n):
@@ -165,6 +173,21 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
                 extra = added_mass_times(X, i, w0, w1, w2, params.added_mass, closed)
                 for d in range(dim):
                     rhs[i * dim + d] -= extra[d]
+        norm = 0.0
+        for u in range(rhs.shape[0]):
+            norm += rhs[u] * rhs[u]
+        if norm > last and stride > BACKTRACK_ABOVE * newton.tol and halvings < MAX_HALVINGS:
+            # the full step made the residual worse (a contact switching on, friction reversing): go back half
+            # of it and look again; a smooth problem never gets here, so its iterates are Newton's own
+            halvings += 1
+            stride *= 0.5
+            for i in range(n):
+                for d in range(dim):
+                    step[i * dim + d] *= 0.5
+                    X[d, i] -= step[i * dim + d]
+            continue
+        last = norm
+        halvings = 0
         newton_matrix(X, V, newton.jac, beta, nodes, params, t_stage)
         if not factor(band, newton.jac.corner, newton.cyclic, p, newton.wood):
             return -1, 0, 0.0, 0.0, 0.0
@@ -173,10 +196,12 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
         for i in range(n):
             for d in range(dim):
                 dx = rhs[i * dim + d]
+                step[i * dim + d] = dx
                 X[d, i] += dx
                 if not abs(dx) <= worst:
                     worst = abs(dx)
                     worst_node = i
+        stride = worst
         if worst <= newton.tol:
             for d in range(dim):
                 for i in range(n):
@@ -186,7 +211,7 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     return -1, worst_node, 0.0, 0.0, 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, frames):
     """Advance ``schedule.n_steps`` SDIRK2 steps in place; the contract of :mod:`ropesim.integrate.base`.
 

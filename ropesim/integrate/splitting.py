@@ -28,8 +28,8 @@ from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
+from ..model.jit import kernel
 from ..model.terms import GRAVITY, accelerations, has_applied, applied_accelerations, mechanical_energy, position_accelerations
 from .base import Integrator, Method
 from .contact import exact_contact_kicks
@@ -215,7 +215,7 @@ class Splitting(Integrator):
                                  self.limits, self.schedule(n), frames)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def advance_splitting(state, kicks, plain, general, held, mass, params, limits, schedule, frames):
     """Advance ``schedule.n_steps`` splitting steps in place, from global step ``schedule.step0``.
 

@@ -19,9 +19,9 @@ from __future__ import annotations
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
 
 from ..model.terms import added_mass, any_applied, applied_accelerations, velocity_accelerations
+from ..model.jit import kernel
 
 RK4_A = (0.0, 0.5, 0.5, 1.0)          # each sub-stage's offset along the kick, as a fraction of tau
 RK4_B = (1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0)
@@ -36,7 +36,7 @@ def velocity_scratch(dim: int, nodes: int) -> VelocityScratch:
                            np.zeros((dim, nodes)))
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def velocity_kick(x, v, acc_x, tau, t, params, mass, gamma, held, scratch):
     """Kick ``v`` over ``tau`` [s] at time ``t`` [s] by RK4 (see the module doc); ``acc_x`` (D, N) holds the
     position-only accelerations, ``gamma`` (N,) the linear drag rates b / m (0 at held nodes).

@@ -12,7 +12,8 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+
+from .jit import kernel
 
 Woodbury = namedtuple("Woodbury", ["wmat", "zmat", "a00", "g", "s", "small", "tmp"])
 """The wrap-around correction's arrays, m = w D: W and Z (N D, m), A00, G and S (m, m), dense-solve scratch
@@ -25,7 +26,7 @@ def woodbury(nt: int, m: int) -> Woodbury:
     return Woodbury(f((nt, m)), f((nt, m)), f((m, m)), f((m, m)), f((m, m)), f((m, m + 1)), f(m))
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def band_cholesky(band, p):
     """In-place Cholesky of a symmetric positive definite band matrix stored as band[q, j] = A[j + q, j]."""
     nt = band.shape[1]
@@ -46,7 +47,7 @@ def band_cholesky(band, p):
     return True
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def band_solve(band, p, r):
     """Solve L L^T z = r in place (``band`` holds L from :func:`_band_cholesky`)."""
     nt = band.shape[1]
@@ -62,7 +63,7 @@ def band_solve(band, p, r):
         r[i] = s / band[0, i]
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def band_solve_columns(band, p, z):
     """Solve L L^T Z = z in place for every column of ``z`` (nt, m) at once: the same operations, in the same
     order, as :func:`band_solve` on each column, with each entry of L loaded once for all columns."""
@@ -83,7 +84,7 @@ def band_solve_columns(band, p, z):
             z[i, c] /= band[0, i]
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def dense_solve(a, rhs, work):
     """Solve a z = rhs (m x m, m x k) in place into ``rhs`` by Gaussian elimination with partial pivoting;
     ``a`` is kept (``work`` is m x m+... scratch of at least m x m)."""
@@ -117,7 +118,7 @@ def dense_solve(a, rhs, work):
             rhs[col, j] = s / lu[col, col]
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def factor(band, corner, cyclic, p, wood):
     """Factor the Newton matrix; with a wrap-around, prepare the Woodbury correction (see the module doc).
 
@@ -151,7 +152,9 @@ def factor(band, corner, cyclic, p, wood):
             wmat[a, a] = 1.0
             for b in range(m):
                 wmat[nt - m + a, b] = -g[b, a]
-        zmat[:] = wmat
+        for r in range(nt):
+            for b in range(m):
+                zmat[r, b] = wmat[r, b]
         band_solve_columns(band, p, zmat)
         for b in range(m):
             for a in range(m):
@@ -167,7 +170,7 @@ def factor(band, corner, cyclic, p, wood):
     return True
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def solve(band, corner, cyclic, p, rhs, wood):
     """Solve the factored Newton system in place into ``rhs`` (flat, node-major)."""
     wmat, zmat, s, small, tmp = wood.wmat, wood.zmat, wood.s, wood.small, wood.tmp

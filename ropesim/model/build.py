@@ -70,8 +70,9 @@ class Model:
                                                                                      for g in scene.guides)
 
 
-def build(scene: S.Scene) -> Model:
-    """Lay out ``scene`` for the kernel."""
+def build(scene: S.Scene, solve: bool = True) -> Model:
+    """Lay out ``scene`` for the kernel; an ``equilibrium`` start is solved for its static shape (unless
+    ``solve`` is False: it then holds the solver's first guess, see :mod:`ropesim.analysis.statics`)."""
     n, dim = scene.rope.nodes, scene.dimension
     x0 = initial_positions(scene)
     v0 = np.empty((dim, n))
@@ -108,7 +109,7 @@ def build(scene: S.Scene) -> Model:
     model = Model(scene=scene, x0=x0, v0=v0, mass=mass, drag=drag, held=held, held_idx=held_idx,
                   held_x0=np.ascontiguousarray(x0[:, held_idx]), held_v=np.ascontiguousarray(held_v[:, held_idx]),
                   params=model_params(scene, layout), motion=motion_of(scene, held_idx))
-    if isinstance(scene.initial, S.EquilibriumStart):
+    if solve and isinstance(scene.initial, S.EquilibriumStart):
         from .statics import solve_equilibrium
 
         result = solve_equilibrium(model)

@@ -19,7 +19,8 @@ from __future__ import annotations
 import math
 from collections import namedtuple
 
-from numba import njit
+from .jit import kernel
+
 
 Jacobian = namedtuple("Jacobian", ["band", "corner", "blk", "w"])
 """band ((w + 1) D, N D), corner (w D, w D), a D x D scratch block, and the half-width w in nodes."""
@@ -31,7 +32,7 @@ def band_width(closed: bool, nodes: int, reach: int) -> tuple[int, bool]:
     return w, bool(closed and nodes >= w + 2)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def slot(n, dim, w, ni, nj, di, dj):
     """Where A[ni*D+di, nj*D+dj] is kept: (0, q, c) for band[q, c], (1, row, c) for the wrap-around's
     corner[row, c], (-1, 0, 0) above the diagonal (only the lower triangle is stored).
@@ -48,7 +49,7 @@ def slot(n, dim, w, ni, nj, di, dj):
     return 1, (ni - (n - w)) * dim + di, c
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_pair(jac, n, i, j, free_i, free_j):
     """Add a coupling's block ``jac.blk``: +blk to (i, i) and (j, j), -blk to (i, j) and (j, i)."""
     band, corner, blk, w = jac
@@ -67,7 +68,7 @@ def add_pair(jac, n, i, j, free_i, free_j):
                     corner[q, c] += sign * blk[a, b]
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def pair_spring_blocks(x, jac, k, rest, stride, closed, scale, free, slack):
     """Add ``scale`` times the stiffness of every spring (i, i + stride) of constant k [N/m] and rest length [m].
 
@@ -101,7 +102,7 @@ def pair_spring_blocks(x, jac, k, rest, stride, closed, scale, free, slack):
         add_pair(jac, n, i, j, free[i], free[j])
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def pair_damper_blocks(x, jac, c, closed, scale, free):
     """Add ``scale`` times the damping c u u^T [N s/m] of every segment (i, i + 1) (the rope's axial damping)."""
     dim, n = x.shape

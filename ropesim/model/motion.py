@@ -20,7 +20,8 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+
+from .jit import kernel
 
 Motion = namedtuple("Motion", ["moving", "base", "amp", "omega", "phase", "ramp", "path_t", "path_d", "span", "accel"])
 
@@ -53,18 +54,21 @@ def motion_of(scene, held_idx: np.ndarray) -> Motion:
                   np.zeros((dim, h)))
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def ramp_factor(t, ramp):
-    """(r, dr/dt, d2r/dt2) of the ramp (1 - cos(pi t / T)) / 2 until T, 1 after (and always when T = 0)."""
+    """(r, dr/dt, d2r/dt2) of the ramp r = 10 s^3 - 15 s^4 + 6 s^5, s = t / T, until T, 1 after (and always
+    when T = 0): "smootherstep", whose rate and acceleration are zero at both ends, so the held node's
+    acceleration, and the force on its support, have no jump when the ramp starts or ends."""
     if ramp <= 0.0 or t >= ramp:
         return 1.0, 0.0, 0.0
     if t <= 0.0:
         return 0.0, 0.0, 0.0
-    w = math.pi / ramp
-    return 0.5 * (1.0 - math.cos(w * t)), 0.5 * w * math.sin(w * t), 0.5 * w * w * math.cos(w * t)
+    u = t / ramp
+    return (u * u * u * (10.0 + u * (-15.0 + 6.0 * u)), u * u * (30.0 + u * (-60.0 + 30.0 * u)) / ramp,
+            u * (60.0 + u * (-180.0 + 120.0 * u)) / (ramp * ramp))
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def offset(m, j, d, t):
     """(position, velocity, acceleration) of held node j's motion along axis d at time t, beyond x0 + V t."""
     s = ds = dds = 0.0
@@ -94,7 +98,7 @@ def offset(m, j, d, t):
     return r * s, dr * s + r * ds, ddr * s + 2.0 * dr * ds + r * dds
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def place_moving(x, v, held, t):
     """Put every held node at its prescribed place at time t, set its velocity in ``v`` and in ``held.v``,
     and its acceleration in ``held.motion.accel``."""

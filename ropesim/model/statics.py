@@ -1,21 +1,30 @@
 """The static shape: every force balanced at every free node, the held nodes where the scene holds them.
 
-Solved by pseudo-transient continuation (a damped Newton method): each iteration solves
+Solved by a damped Newton method with a line search on the potential energy. Each iteration takes the step d
+of an overdamped implicit step of the dynamics (pseudo-transient continuation),
 
-    (M / tau^2 + C / tau + K) dx = F(x),
+    (M / tau^2 + C / tau + K) d = F(x),
 
 K the stiffness and C the damping of the force terms (the stiff integrator's Newton matrix, here at zero
 velocity, :func:`ropesim.model.terms.newton_matrix` divided by tau^2), F the net static force (weight,
-buoyancy, springs, bending, the seabed's contact, drag in the flow at its full strength, nodes at rest). With
-a small pseudo-time step tau this is an overdamped implicit step of the dynamics, which a slack chain or a
-seabed touchdown needs (K alone is singular or indefinite there). Each accepted step doubles tau, so the steps
-grow into Newton's (tau -> infinity) as the shape settles; a step that makes the residual norm grow tenfold
-(contact found deep inside the seabed, a segment overstretched) is undone and tau quartered; and no node moves
-more than a quarter of a segment in one step (a trust region: the Jacobian is only local). The banded solves
-make each iteration O(N).
+buoyancy, springs, bending, the seabed's contact, drag in the flow at its full strength, nodes at rest). With a
+small pseudo-time step tau this is a short gradient step (K alone is singular or indefinite for a slack chain
+or at a seabed touchdown); as tau grows it becomes Newton's step. The step is then shortened until it lowers
+the merit
+
+    phi(a) = E(x + a d) - a d . F_nc(x),
+
+E the potential energy of the conservative terms (springs, bending, gravity, buoyancy, the seabed's contact)
+and F_nc the rest (drag in the flow), which phi holds at its value at x; its slope at a = 0 is -d . F < 0
+(Armijo's condition, with a factor 1e-4). Stiff springs make the residual force a poor judge of a step (a
+slack segment drawn 1 cm past its rest length gives 5e6 N on a chain) where the energy is not: the line
+search takes the fraction of the step at which the segment comes taut. A full step doubles tau, a shortened
+one keeps it, a failed one quarters it; no node moves more than a segment in one step (a trust region: the
+Jacobian is only local). Near the solution, where the energy's changes reach its round-off, a step is also
+taken when it halves the residual. The banded solves make each iteration O(N).
 
 Converged when the largest residual force on a free node is below ``tol`` times the largest force any term
-puts on a node (its weight, or its spring's pull), by default 1e-10.
+puts on a node (its weight, or its spring's pull at 1 % strain), by default 1e-10.
 """
 
 from __future__ import annotations
@@ -24,11 +33,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from .banded import factor, solve, woodbury
 from .jacobian import Jacobian, band_width
-from .terms import accelerations, coupling_reach, newton_matrix
+from .terms import accelerations, coupling_reach, mechanical_energy, newton_matrix, velocity_accelerations
+from .jit import kernel
 
 TOL = 1e-10
 MAX_ITERATIONS = 2000
@@ -45,7 +54,7 @@ class Equilibrium:
     converged: bool
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def _forces(x, v, acc, p, t, mass, free, out):
     """The net static force [N] on every free node (0 on held nodes) into ``out`` (flat, node-major); returns
     its largest component."""
@@ -68,6 +77,7 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     dim, n = x.shape
     scene, p = model.scene, model.params
     free = np.ascontiguousarray(~model.held)
+    mass = model.mass
     v = np.zeros_like(x)
     acc = np.zeros_like(x)
     t = _steady_time(scene)
@@ -75,13 +85,14 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     nt, m = dim * n, w * dim
     jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
     wood = woodbury(nt, m)
-    nodes = (free, model.mass, np.where(model.held, 0.0, model.drag))
-    force, trial = np.zeros(nt), np.zeros(nt)
+    nodes = (free, mass, np.where(model.held, 0.0, model.drag))
+    force, trial, other = np.zeros(nt), np.zeros(nt), np.zeros(nt)
     scale = _force_scale(model)
-    worst = _forces(x, v, acc, p, t, model.mass, free, force)
+    worst = _forces(x, v, acc, p, t, mass, free, force)
     norm = float(np.linalg.norm(force))
-    tau = math.sqrt(float(model.mass[free].min()) / max(scene.rope.stiffness, 1e-300))   # one spring's period
-    reach = 0.25 * scene.rope.segment_length
+    energy = _energy(x, v, mass, p)
+    tau = math.sqrt(float(mass[free].min()) / max(scene.rope.stiffness, 1e-300))   # one spring's period
+    reach = scene.rope.segment_length
     for iteration in range(1, max_iterations + 1):
         if worst <= tol * scale:
             return Equilibrium(x, worst, scale, iteration - 1, True)
@@ -94,17 +105,53 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
         largest = float(np.abs(step).max())
         if largest > reach:
             step *= reach / largest
-        candidate = x + step.reshape(n, dim).T
-        better = _forces(candidate, v, acc, p, t, model.mass, free, trial)
-        new_norm = float(np.linalg.norm(trial))
-        if not new_norm <= 10.0 * norm:
+        slope = -float(step @ force)
+        if not slope < 0.0:          # not downhill (a non-conservative force turned it): a shorter pseudo-step
             tau *= 0.25
             if tau < 1e-30:
                 break
             continue
-        tau = min(2.0 * tau, 1e12)
-        x, worst, norm, force, trial = candidate, better, new_norm, trial, force
+        _nonconservative(x, v, acc, p, t, mass, free, other)
+        drift = float(step @ other)
+        fraction, accepted = 1.0, False
+        while fraction > 1e-6:
+            candidate = x + fraction * step.reshape(n, dim).T
+            trial_energy = _energy(candidate, v, mass, p)
+            better = _forces(candidate, v, acc, p, t, mass, free, trial)
+            new_norm = float(np.linalg.norm(trial))
+            change = trial_energy - energy - fraction * drift
+            if change <= 1e-4 * fraction * slope or (
+                    abs(change) <= 1e-12 * max(abs(energy), 1.0) and new_norm <= 0.5 * norm):
+                accepted = True
+                break
+            fraction *= 0.5
+        if not accepted:
+            tau *= 0.25
+            if tau < 1e-30:
+                break
+            continue
+        if fraction == 1.0:
+            tau = min(2.0 * tau, 1e12)
+        x, worst, norm, force, trial, energy = candidate, better, new_norm, trial, force, trial_energy
     return Equilibrium(x, worst, scale, max_iterations, worst <= tol * scale)
+
+
+def _energy(x, v, mass, p) -> float:
+    return float(mechanical_energy(x, v, mass, p)[0])
+
+
+@kernel
+def _nonconservative(x, v, acc, p, t, mass, free, out):
+    """The force [N] of the terms that are not conservative (drag in the flow; the others vanish at rest) on
+    every free node into ``out`` (flat, node-major)."""
+    dim, n = x.shape
+    for i in range(n):
+        for d in range(dim):
+            acc[d, i] = 0.0
+    velocity_accelerations(x, v, acc, p, t)
+    for i in range(n):
+        for d in range(dim):
+            out[i * dim + d] = mass[i] * acc[d, i] if free[i] else 0.0
 
 
 def _steady_time(scene) -> float:

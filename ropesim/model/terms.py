@@ -25,13 +25,13 @@ Compiled entry points, each the term list in one form:
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
 
 from .forces.added_mass import ADDED_MASS_TERM, add_added_mass_jacobian, apply_added_mass
 from .forces.bending import EI_TERM, add_ei_bending, add_ei_jacobian, ei_energy
 from .forces.buoyancy import BUOYANCY_TERM, add_buoyancy
 from .forces.fluid import (BODY_DRAG_TERM, FLOW_PUSH_TERM, FLOW_TERM, FLUID_DRAG_TERM, VISCOUS_DRAG_TERM,
                            add_fluid_forces, add_fluid_jacobian)
+from .forces.flow_inertia import FLOW_INERTIA_TERM, add_flow_inertia
 from .forces.gravity import GRAVITY as GRAVITY_TERM
 from .forces.guides import GUIDES as GUIDES_TERM
 from .forces.guides import add_guides, add_guides_jacobian
@@ -44,22 +44,24 @@ from .forces.seabed import (SEABED_TERM, add_seabed_contact, add_seabed_friction
 from .forces.thrower import THROWER as THROWER_TERM
 from .forces.thrower import add_thrower, add_thrower_jacobian
 from .jacobian import pair_damper_blocks, pair_spring_blocks
+from .jit import kernel
 
 TERMS = (ROPE, BENDING_TERM, GRAVITY_TERM, BUOYANCY_TERM, THROWER_TERM, GUIDES_TERM, AXIAL_DAMPING_TERM,
          FLUID_DRAG_TERM, VISCOUS_DRAG_TERM, BODY_DRAG_TERM, FLOW_TERM, FLOW_PUSH_TERM, ADDED_MASS_TERM, SEABED_TERM,
-         EI_TERM)
+         EI_TERM, FLOW_INERTIA_TERM)
 
 # Positions in ModelParams.flags (uint8), one per optional term: each Term's ``flag``.
 BENDING, GRAVITY, THROWER, GUIDES = BENDING_TERM.flag, GRAVITY_TERM.flag, THROWER_TERM.flag, GUIDES_TERM.flag
 AXIAL_DAMPING, BUOYANCY = AXIAL_DAMPING_TERM.flag, BUOYANCY_TERM.flag
 FLUID_DRAG, VISCOUS_DRAG, BODY_DRAG = FLUID_DRAG_TERM.flag, VISCOUS_DRAG_TERM.flag, BODY_DRAG_TERM.flag
 FLOW, FLOW_PUSH, ADDED_MASS = FLOW_TERM.flag, FLOW_PUSH_TERM.flag, ADDED_MASS_TERM.flag
-SEABED, EI_BENDING = SEABED_TERM.flag, EI_TERM.flag
-N_FLAGS = 14
+SEABED, EI_BENDING, FLOW_INERTIA = SEABED_TERM.flag, EI_TERM.flag, FLOW_INERTIA_TERM.flag
+N_FLAGS = 15
 
 ModelParams = namedtuple("ModelParams", [
     "inv_mass", "flags", "node_length", "spring", "bending", "gravity", "buoyancy", "thrower", "guides", "axial",
-    "fluid_drag", "viscous_drag", "body_drag", "flow", "flow_push", "added_mass", "seabed", "bending_ei"])
+    "fluid_drag", "viscous_drag", "body_drag", "flow", "flow_push", "added_mass", "seabed", "bending_ei",
+    "flow_inertia"])
 """What the compiled code knows of the model's forces: 1 / m per node (N,), the on/off flags (N_FLAGS,), each
 node's share of unstretched length (N,) [m], and each term's parameters, in TERMS order (see each term's
 module for its layout)."""
@@ -100,20 +102,20 @@ def has_applied(p: ModelParams) -> bool:
     return bool(p.flags[THROWER] or p.flags[GUIDES])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def any_applied(flags):
     """True when a term of the ledger's ``box_work`` (the thrower, the guides) is on."""
     return flags[THROWER] != 0 or flags[GUIDES] != 0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def any_fluid(flags):
     """True when a term acting through the fluid (drag on the relative velocity, a flow's push) is on."""
     return (flags[FLUID_DRAG] != 0 or flags[VISCOUS_DRAG] != 0 or flags[BODY_DRAG] != 0
             or flags[FLOW_PUSH] != 0)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def position_accelerations(x, acc, p):
     """Overwrite ``acc`` (D, N) with the acceleration [m/s^2] of the terms that depend on positions alone."""
     closed = p.spring[2] != 0.0
@@ -129,11 +131,11 @@ def position_accelerations(x, acc, p):
         add_ei_bending(x, acc, p.inv_mass, p.bending_ei, closed)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def velocity_accelerations(x, v, acc, p, t):
-    """Add the acceleration [m/s^2] of the terms that depend on velocities (the thrower, the guides, axial
-    damping, fluid forces, the seabed's damping and friction) at time t [s]; returns the power [W] of the
-    fluid, of the axial damping and of the seabed."""
+    """Add the acceleration [m/s^2] of the terms that depend on velocities or time (the thrower, the guides,
+    axial damping, fluid forces, the accelerating water's, the seabed's damping and friction) at time t [s];
+    returns the power [W] of the fluid, of the axial damping and of the seabed."""
     closed = p.spring[2] != 0.0
     g = p.gravity[0] if p.flags[GRAVITY] else 0.0
     if p.flags[THROWER]:
@@ -146,13 +148,15 @@ def velocity_accelerations(x, v, acc, p, t):
     fluid = 0.0
     if any_fluid(p.flags):
         fluid = add_fluid_forces(x, v, acc, p, t)
+    if p.flags[FLOW_INERTIA]:
+        fluid += add_flow_inertia(x, v, acc, p.inv_mass, p.flow_inertia, p.flow, t, closed)
     seabed = 0.0
     if p.flags[SEABED]:
         seabed = add_seabed_friction(x, v, acc, p.inv_mass, p.seabed, closed)
     return fluid, internal, seabed
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def accelerations(x, v, acc, p, t):
     """Overwrite ``acc`` (D, N) with every term's force / m [m/s^2] at time t [s], the linear [drag] b v and
     added mass excluded; returns the power [W] of the fluid, the axial damping and the seabed."""
@@ -160,7 +164,7 @@ def accelerations(x, v, acc, p, t):
     return velocity_accelerations(x, v, acc, p, t)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def added_mass(x, v, acc, p):
     """With added mass on, turn ``acc`` (every force / m, drag included) into M^-1 F; returns the power [W] of
     the fluid's inertial force (0 without added mass)."""
@@ -169,7 +173,7 @@ def added_mass(x, v, acc, p):
     return 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def applied_accelerations(x, v, out, p):
     """Overwrite ``out`` (D, N) with the non-conservative terms' part of the acceleration [m/s^2] alone (the
     thrower's and guides'); zero when none is on. The energy ledger books their work as ``box_work``."""
@@ -181,7 +185,7 @@ def applied_accelerations(x, v, out, p):
         add_guides(x, v, out, p.guides, p.thrower, p.flags[THROWER] != 0, g)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def _springs_energy_and_stretch(x, k, rest, stride, closed, slack):
     dim, n = x.shape
     count = n if closed else n - stride
@@ -205,7 +209,7 @@ def _springs_energy_and_stretch(x, k, rest, stride, closed, slack):
     return energy, worst / rest, where
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def mechanical_energy(x, v, mass, p):
     """(kinetic + spring + bending + gravitational + buoyancy energy [J], largest spring length / rest length,
     its node). Checked every few steps by the run loop to catch a blow-up (runaway energy or an insane
@@ -231,7 +235,7 @@ def mechanical_energy(x, v, mass, p):
     return e, stretch, node
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def coupling_jacobian(x, jac, beta, free, p):
     """Add the coupling terms' blocks for a stage of coefficient beta = gamma h: beta^2 times the springs' and
     bending's stiffness, beta times the axial damping."""
@@ -246,7 +250,7 @@ def coupling_jacobian(x, jac, beta, free, p):
         add_ei_jacobian(x, jac, beta, free, p.bending_ei, p.spring[1], closed)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def node_jacobian(x, v, band, beta, mass, free, p, t):
     """Add the node-local terms' blocks (the thrower's, the guides', the fluid's, added mass) to the Newton
     matrix's ``band``, for a stage of coefficient beta = gamma h at time t (see :mod:`ropesim.model.jacobian`)."""
@@ -262,7 +266,7 @@ def node_jacobian(x, v, band, beta, mass, free, p, t):
         add_seabed_jacobian(x, v, band, beta, free, p.seabed, True)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def newton_matrix(x, v, jac, beta, nodes, p, t):
     """The matrix M (1 + beta gamma) + beta^2 H + beta C_v into ``jac`` (:mod:`ropesim.model.jacobian`): the
     mass and linear drag on the diagonal, then every term's blocks. ``nodes`` = (free (N,) bool, mass (N,),

@@ -69,10 +69,19 @@ def origin(x: np.ndarray, nodes: np.ndarray | None) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Box:
-    """An axis-aligned rectangle in the picture's coordinates [m] (the thrower box)."""
+    """A rectangle in the picture's coordinates [m] (the thrower box): half-sides ``half`` along its own axes,
+    turned by ``angle`` [deg] counter-clockwise about its centre (0: axis-aligned)."""
 
     center: tuple[float, float]
     half: tuple[float, float]
+    angle: float = 0.0
+
+    def corners(self) -> np.ndarray:
+        """The four corners (4, 2) [m]."""
+        a = np.radians(self.angle)
+        rot = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
+        local = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * np.asarray(self.half)
+        return np.asarray(self.center) + local @ rot.T
 
 
 @dataclass(frozen=True)
@@ -98,16 +107,25 @@ class Band:
 def outline(model: Model, proj: Projection) -> list:
     """The scene's fixed geometry projected on ``proj``: the thrower box, then the guide circles.
 
-    The box is |x - cx| < L/2, |y - cy| < W/2 (and |z - cz| < W/2); a guide is a circle in x-y, a cylinder
-    along z in 3-D.
+    The box is |x - cx| < L/2, |y - cy| < W/2 (and |z - cz| < W/2), turned by its launch angle in x-y: drawn
+    turned in the x-y view, and as the extent of the turned box in a view along x or y; a guide is a circle in
+    x-y, a cylinder along z in 3-D.
     """
     scene = model.scene
     a, b = proj.axes
     shapes: list = []
     if scene.thrower is not None:
         t = scene.thrower
-        half = (t.length / 2, t.width / 2, t.width / 2)
-        shapes.append(Box((t.center[a], t.center[b]), (half[a], half[b])))
+        if t.angle == 0.0:
+            half = (t.length / 2, t.width / 2, t.width / 2)
+            shapes.append(Box((t.center[a], t.center[b]), (half[a], half[b])))
+        elif proj.axes in ((0, 1), (1, 0)):
+            sign = 1.0 if proj.axes == (0, 1) else -1.0    # the y-x view mirrors the turn
+            shapes.append(Box((t.center[a], t.center[b]), (t.length / 2, t.width / 2), sign * t.angle))
+        else:
+            c, s = (abs(f) for f in t.direction)
+            half = (c * t.length / 2 + s * t.width / 2, s * t.length / 2 + c * t.width / 2, t.width / 2)
+            shapes.append(Box((t.center[a], t.center[b]), (half[a], half[b])))
     for g in scene.guides:
         if 2 not in proj.axes:
             shapes.append(Circle((g.center[a], g.center[b]), g.radius, g.one_sided))
@@ -122,8 +140,8 @@ def outline_extent(shapes: list) -> tuple[np.ndarray, np.ndarray]:
     lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
     for s in shapes:
         if isinstance(s, Box):
-            c, h = np.asarray(s.center), np.asarray(s.half)
-            lo, hi = np.minimum(lo, c - h), np.maximum(hi, c + h)
+            corners = s.corners()
+            lo, hi = np.minimum(lo, corners.min(axis=0)), np.maximum(hi, corners.max(axis=0))
         elif isinstance(s, Circle):
             c = np.asarray(s.center)
             lo, hi = np.minimum(lo, c - s.radius), np.maximum(hi, c + s.radius)

@@ -42,7 +42,8 @@ class Geometry:
         for shape in outline(model, proj):
             if isinstance(shape, Box):
                 (cx, cy), (hx, hy) = shape.center, shape.half
-                patch = Rectangle((cx - hx, cy - hy), 2 * hx, 2 * hy, zorder=1, **GEOMETRY)
+                patch = Rectangle((cx - hx, cy - hy), 2 * hx, 2 * hy, angle=shape.angle, rotation_point="center",
+                                  zorder=1, **GEOMETRY)
             elif isinstance(shape, Circle):
                 patch = CirclePatch(shape.center, shape.radius, fill=False, zorder=2,
                                     linestyle="--" if shape.one_sided else "-",

@@ -29,6 +29,9 @@ class SceneError(ValueError):
         where = f"{source}: {key}: " if key else f"{source}: "
         super().__init__(" ".join(f"{where}{message}".split()))
 
+    def __reduce__(self):   # picklable, so a sweep's worker process hands the real message back
+        return SceneError, (self.source, self.key, self.message)
+
 
 def load_scene(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> S.Scene:
     """Load and validate a scene file, or a built-in scene by name ("helicopter_mass"; a file that exists
@@ -320,7 +323,7 @@ def _check_seabed(scene: S.Scene, fail) -> None:
                                      "it, or rope.diameter")
     from .shapes import initial_positions
 
-    x = initial_positions(scene)
+    x = initial_positions(replace(scene, seabed=None))   # where the scene puts them (a sagging guess is lifted)
     slope = math.radians(bed.slope)
     below = (bed.height + math.tan(slope) * x[0] - x[1]) * math.cos(slope)
     held = set(scene.pinned.nodes if scene.pinned else ()) | {i for d in scene.driven for i in d.nodes}
@@ -382,6 +385,13 @@ def _resolve_rope(rope: S.Rope, source: str) -> S.Rope:
         if given is not None and not _agree(given, value):
             fail(key, f"{given:g} contradicts the physical form, which gives {value:g}; give one form, or both "
                       f"consistently")
+    origin = {"segment_length": ("length", "length / segments"), "stiffness": ("EA", "EA / l"),
+              "mass": ("mass_per_length", "mass_per_length x l")}
+    for key, (physical, how) in origin.items():   # the derived per-node values obey the per-node keys' limits
+        value, spec = derived[key], {f.name: f.metadata["spec"] for f in fields(S.Rope)}[key]
+        if not MIN_POSITIVE <= value <= MAX_MAGNITUDE:
+            fail(physical, f"gives {key} = {how} = {value:g}{_unit(spec)}, outside {MIN_POSITIVE:g} to "
+                           f"{MAX_MAGNITUDE:g} (its products and ratios would overflow)")
     return replace(rope, segments=segments, mass_per_length=per_metre,
                    compression=False if rope.compression is None else rope.compression, **derived)
 
@@ -403,8 +413,11 @@ def _check_fluid(scene: S.Scene, fail) -> None:
     if scene.buoyancy is not None and scene.gravity is None:
         fail("buoyancy", "needs [gravity]: buoyancy is the fluid's weight displaced")
     drags = [k for k in ("drag", "fluid_drag", "viscous_drag") if getattr(scene, k) is not None]
-    if scene.flow is not None and not drags and not any(b.cd_area > 0 for b in scene.bodies):
-        fail("flow", "moves the rope only through drag: add [drag], [fluid_drag], [viscous_drag] or a body "
+    inertia = scene.flow is not None and scene.flow.ramp_time > 0 and (
+        scene.buoyancy is not None or scene.added_mass is not None or any(b.ca > 0 for b in scene.bodies))
+    if scene.flow is not None and not drags and not inertia and not any(b.cd_area > 0 for b in scene.bodies):
+        fail("flow", "moves the rope only through drag (and, while it ramps in, through buoyancy or added "
+                     "mass): add [drag], [fluid_drag], [viscous_drag] or a body "
                      "with cd_area")
     flow = scene.flow
     if flow is not None:

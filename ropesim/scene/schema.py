@@ -109,9 +109,10 @@ class Rope:
 class Seabed:
     """A seabed or ground: the plane y = height + tan(slope) x, with the scene's nodes pushed out of it.
 
-    A node that sinks a depth delta below the plane (measured along its normal n) feels
-    (k delta - c v_n) A along n, A = contact_width x L (its share of unstretched length), with the contact
-    stiffness k and damping c per unit area (MoorDyn's kBot and cBot; MoorDyn's defaults). Sliding on it, the
+    A node that sinks a depth delta below the plane (measured along its normal n) feels k delta A along n,
+    A = contact_width x L (its share of unstretched length), plus the damping c |v_n| A while it moves into the
+    plane (none while it moves out: the seabed is not sticky), grown in over the first 1e-3 footprint widths
+    of depth; the contact stiffness k and damping c per unit area are MoorDyn's kBot and cBot (its defaults). Sliding on it, the
     node feels Coulomb-like friction against its sliding velocity v_s (v minus its normal part), split along
     and across the rope (the node tangent projected on the plane):
 
@@ -378,9 +379,10 @@ class Driven:
     ``period`` T, ``phase`` phi in degrees; an axis with A = 0 stays still) and a piecewise-linear ``path`` p(t)
     read from a CSV file of rows t, dx, dy[, dz] or given inline as ``path_table`` (displacements, p(0) = 0,
     times increasing and covering the run; the loader reads the file into ``path_table``, so a resolved scene
-    carries its path with it), both ramped in by r(t) = (1 - cos(pi t / ramp_time)) / 2 until ``ramp_time`` (1 from then on, or
-    always when it is 0). The node's velocity and acceleration follow; the force its support exerts is
-    reported (``support`` in each saved frame).
+    carries its path with it), both ramped in by r(t) = 10 s^3 - 15 s^4 + 6 s^5, s = t / ``ramp_time``, until
+    ``ramp_time`` (1 from then on, or always when it is 0; its rate and acceleration vanish at both ends, so
+    the motion starts and settles without a jolt). The node's velocity and acceleration follow; the force its
+    support exerts is reported (``support`` in each saved frame).
     """
 
     nodes: tuple = spec("int_list", "indices of the driven nodes (negative counts from the end)")
@@ -412,6 +414,10 @@ class Thrower:
     Inside it a node feels F_x = b_thrower (v_max - v_x) along the box, and across it a critically damped
     spring towards the centre line that also cancels gravity: F_y = m g - m omega0^2 (y - cy)
     - 2 zeta m omega0 v_y (likewise in z). omega0 defaults to 2 (2 pi v_max / L).
+
+    ``angle`` (the launch angle alpha) turns the box and its drive about its centre in the x-y plane, positive
+    upward (counter-clockwise): the drive then acts along (cos alpha, sin alpha) and the centring spring across
+    it, while the weight is still cancelled along y. The guide circles are not moved: place them yourself.
     """
 
     center: tuple = spec("vector", "centre of the box", "m")
@@ -425,6 +431,14 @@ class Thrower:
                                 low=0)
     edge_width: float = spec("float", "width w over which the box's edges switch its forces on (0 = sharp)", "m",
                              default=0.0, low=0)
+    angle: float = spec("float", "launch angle: the box and its drive turned about its centre in the x-y plane, "
+                                 "positive upward (0 = along +x)", "deg", default=0.0, low=-90, high=90)
+
+    @property
+    def direction(self) -> tuple[float, float]:
+        """(cos alpha, sin alpha): the drive's direction in the x-y plane ((1.0, 0.0) exactly at angle 0)."""
+        alpha = math.radians(self.angle)
+        return math.cos(alpha), math.sin(alpha)
 
     @property
     def resolved_omega0(self) -> float:

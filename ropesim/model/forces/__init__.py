@@ -45,9 +45,9 @@ class Term:
     - ``ledger``: for a non-conservative term, the energy ledger's column that books its work: "box" (the
       thrower and guides: :func:`ropesim.model.terms.applied_accelerations`), "fluid" (drag on the velocity
       relative to the flow, added mass) or "internal" (the rope's axial damping); None for a conservative term;
-    - ``velocity``: True when its force depends on the velocities (the splitting schemes then integrate their
-      kicks with RK4 sub-steps, see :mod:`ropesim.integrate.velocity_kick`), except the thrower's and guides',
-      which keep their own exact or plain kicks;
+    - ``velocity``: True when its force depends on the velocities or on time (the splitting schemes then
+      integrate their kicks with RK4 sub-steps, see :mod:`ropesim.integrate.velocity_kick`), except the
+      thrower's and guides', which keep their own exact or plain kicks;
     - ``active(scene)``: whether the scene switches the term on, when that is more than declaring its table;
     - ``reach``: how many places along the rope the term couples nodes (0 for a node-local term), which sets
       the stiff integrator's band width; its Jacobian blocks go in through

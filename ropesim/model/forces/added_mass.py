@@ -14,15 +14,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from . import Term
 from .fluid import node_tangent
+from ..jit import kernel
 
 ADDED_MASS = 11   # its flag
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def apply_added_mass(x, v, acc, added, inv_mass, closed):
     """Turn ``acc`` (D, N), each node's F / m, into M^-1 F (see the module doc); returns the power [W] of the
     fluid's inertial force m a - F on the nodes moving at ``v``."""
@@ -50,7 +50,7 @@ def apply_added_mass(x, v, acc, added, inv_mass, closed):
     return power
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_added_mass_jacobian(x, band, added, free, closed):
     """Add each free node's added-mass block A_i = a_n (I - q q^T) + a_t q q^T to the Newton matrix's band (the
     stiff integrator's residual carries M_i = m_i I + A_i; the tangent is frozen in this block)."""
@@ -65,7 +65,7 @@ def add_added_mass_jacobian(x, band, added, free, closed):
                 band[a - b, i * dim + b] += added[0, i] * ((1.0 if a == b else 0.0) - qq) + added[1, i] * qq
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def added_mass_times(x, i, w0, w1, w2, added, closed):
     """A_i w for node i (the added-mass matrix times a vector (w0, w1, w2)), as a tuple."""
     q = node_tangent(x, i, closed)

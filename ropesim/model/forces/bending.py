@@ -30,15 +30,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from . import Term
 from ..jacobian import add_pair
+from ..jit import kernel
 
 EI_BENDING = 13   # its flag
 
 
-@njit(cache=True)
+@kernel
 def _joint(i, n, closed):
     """Joint i's neighbours (lo, hi) and, for an open line's end node, its clamp row (0 or 1) with hi the
     segment's far node; row -1 for an interior joint."""
@@ -49,7 +49,7 @@ def _joint(i, n, closed):
     return (i - 1 if i > 0 else n - 1), (i + 1 if i < n - 1 else 0), -1
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_ei_bending(x, acc, inv_mass, bending, closed):
     """Add the bending couple's accelerations [m/s^2] of every joint (see the module doc)."""
     stiffness, clamps = bending
@@ -89,7 +89,7 @@ def add_ei_bending(x, acc, inv_mass, bending, closed):
             acc[2, i] -= (h2 + l2) * inv_mass[i]
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def _add_clamp(x, acc, inv_mass, c, u, end, next_node):
     """A clamp at node ``end``: E = c (1 - u . t), t the unit vector from ``end`` to ``next_node``; the force
     c (u - (u . t) t) / |b| on ``next_node`` and its opposite on the (held) end."""
@@ -108,7 +108,7 @@ def _add_clamp(x, acc, inv_mass, c, u, end, next_node):
             acc[d, end] -= f * (ud - cos * bd) * inv_mass[end]
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def ei_energy(x, bending, closed):
     """The bending energy, sum of C_i (1 - cos theta_i) [J] (a clamp's against its direction)."""
     stiffness, clamps = bending
@@ -140,7 +140,7 @@ def ei_energy(x, bending, closed):
     return e
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_ei_jacobian(x, jac, beta, free, bending, rest, closed):
     """Add beta^2 times the small-angle bending stiffness (see the module doc) to the Newton matrix ``jac``,
     as 2 pair(i-1, i) + 2 pair(i, i+1) - pair(i-1, i+1) of the block C_i / l^2 (I - q q^T); a clamp's, C / l^2

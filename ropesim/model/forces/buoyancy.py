@@ -10,14 +10,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from . import Term
+from ..jit import kernel
 
 BUOYANCY = 5   # its flag
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_buoyancy(acc, up):
     """Add each node's upward acceleration ``up`` [m/s^2] (along +y)."""
     for i in range(up.shape[0]):

@@ -29,9 +29,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from . import Term
+from ..jit import kernel
 
 FLUID_DRAG, VISCOUS_DRAG, BODY_DRAG, FLOW, FLOW_PUSH = 6, 7, 8, 9, 10   # their flags (Term.flag below)
 UNIFORM, POWER_LAW, TABLE = 0, 1, 2
@@ -39,7 +39,7 @@ PROFILES = {"uniform": UNIFORM, "power_law": POWER_LAW, "table": TABLE}
 FLOW_PARAMS = 8
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def ramp(t, ramp_time):
     """The flow's ramp factor at time t [s]: (1 - cos(pi t / T)) / 2 until T, then 1."""
     if ramp_time <= 0.0 or t >= ramp_time:
@@ -49,10 +49,16 @@ def ramp(t, ramp_time):
     return 0.5 * (1.0 - math.cos(math.pi * t / ramp_time))
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def flow_at(y, t, flow, table):
     """The flow velocity (Ux, Uy, Uz) [m/s] at height y [m] and time t [s] (see the module doc)."""
-    s = ramp(t, flow[1])
+    return flow_scaled(y, ramp(t, flow[1]), flow, table)
+
+
+@kernel
+def flow_scaled(y, s, flow, table):
+    """The flow's full profile at height y [m] times s: its velocity with s the ramp's factor, its local
+    acceleration with s the ramp's rate."""
     kind = int(flow[0])
     if kind == TABLE:
         k = table.shape[0]
@@ -77,7 +83,7 @@ def flow_at(y, t, flow, table):
     return s * flow[5], s * flow[6], s * flow[7]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@kernel(inline="always")
 def node_tangent(x, i, closed):
     """The unit tangent (qx, qy, qz) of node i (see the module doc); (0, 0, 0) when it has none."""
     dim, n = x.shape
@@ -95,7 +101,7 @@ def node_tangent(x, i, closed):
     return qx / r, qy / r, qz / r
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_fluid_forces(x, v, acc, p, t):
     """Add the fluid forces (see the module doc) of every free-or-held node as accelerations [m/s^2]; returns
     their power [W] on the rope (held nodes included: their supports take it)."""
@@ -152,7 +158,7 @@ def add_fluid_forces(x, v, acc, p, t):
 
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_fluid_jacobian(x, v, band, beta, free, p, t):
     """Add beta C to the Newton matrix's node blocks (see :mod:`ropesim.model.jacobian`), C = -dF/dv the fluid
     forces' damping at the current state, with the tangent frozen (its dependence on positions is left out):
@@ -166,7 +172,8 @@ def add_fluid_jacobian(x, v, band, beta, free, p, t):
     quadratic, linear, body, moving = (flags[FLUID_DRAG] != 0, flags[VISCOUS_DRAG] != 0, flags[BODY_DRAG] != 0,
                                        flags[FLOW] != 0)
     flow, table = p.flow
-    blk = np.zeros((3, 3))
+    c_n, c_t = p.fluid_drag[0], p.fluid_drag[1]
+    b_n, b_t = p.viscous_drag[0], p.viscous_drag[1]
     for i in range(n):
         if not free[i]:
             continue
@@ -174,33 +181,31 @@ def add_fluid_jacobian(x, v, band, beta, free, p, t):
         if moving:
             ux, uy, uz = flow_at(x[1, i], t, flow, table)
         r = (v[0, i] - ux, v[1, i] - uy, v[2, i] - uz if dim == 3 else 0.0)
-        blk[:] = 0.0
+        q = (0.0, 0.0, 0.0)
+        nv = (0.0, 0.0, 0.0)
+        along = speed_n = length = 0.0
         if quadratic or linear:
             q = node_tangent(x, i, closed)
             along = r[0] * q[0] + r[1] * q[1] + r[2] * q[2]
             nv = (r[0] - along * q[0], r[1] - along * q[1], r[2] - along * q[2])
             speed_n = math.sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2])
             length = p.node_length[i]
-            for a in range(3):
-                for b in range(3):
-                    proj = (1.0 if a == b else 0.0) - q[a] * q[b]
-                    qq = q[a] * q[b]
-                    if quadratic:
-                        blk[a, b] += p.fluid_drag[0] * length * speed_n * proj
-                        if speed_n > 0.0:
-                            blk[a, b] += p.fluid_drag[0] * length * nv[a] * nv[b] / speed_n
-                        blk[a, b] += 2.0 * p.fluid_drag[1] * length * abs(along) * qq
-                    if linear:
-                        blk[a, b] += length * (p.viscous_drag[0] * proj + p.viscous_drag[1] * qq)
-        if body and p.body_drag[i] > 0.0:
-            speed = math.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
-            if speed > 0.0:
-                for a in range(3):
-                    for b in range(3):
-                        blk[a, b] += p.body_drag[i] * (speed * (1.0 if a == b else 0.0) + r[a] * r[b] / speed)
+        c_b = p.body_drag[i] if body else 0.0
+        speed = math.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) if c_b > 0.0 else 0.0
         for a in range(dim):
             for b in range(a + 1):
-                band[a - b, i * dim + b] += beta * blk[a, b]
+                unit = 1.0 if a == b else 0.0
+                qq = q[a] * q[b]
+                c = 0.0
+                if quadratic:
+                    c += c_n * length * speed_n * (unit - qq) + 2.0 * c_t * length * abs(along) * qq
+                    if speed_n > 0.0:
+                        c += c_n * length * nv[a] * nv[b] / speed_n
+                if linear:
+                    c += length * (b_n * (unit - qq) + b_t * qq)
+                if speed > 0.0:
+                    c += c_b * (speed * unit + r[a] * r[b] / speed)
+                band[a - b, i * dim + b] += beta * c
 
 
 def speed_scale(model) -> float:

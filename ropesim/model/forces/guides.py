@@ -14,16 +14,16 @@ Parameters: one row per circle, float64 (M, 7): cx, cy, R, omega0^2, 2 zeta omeg
 """
 
 import numpy as np
-from numba import njit
 
 from . import Term
 
 from .thrower import box_of, smooth_step, weight_at
+from ..jit import kernel
 
 GUIDE_PARAMS = 7
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_guides(x, v, acc, circles, box, has_box, g):
     """Add the guide circles' accelerations [m/s^2]; ``box`` is the thrower's parameters if ``has_box``."""
     n = x.shape[1]
@@ -60,7 +60,7 @@ def add_guides(x, v, acc, circles, box, has_box, g):
 
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_guides_jacobian(x, v, band, beta, mass, free, circles, box, has_box):
     """Add the circles' node blocks to the stiff integrator's Newton matrix (see :mod:`ropesim.model.jacobian`).
 

@@ -12,12 +12,12 @@ The rope's parameters: k [N/m], l0 [m], closed (1 or 0), slack (1: no compressio
 """
 
 import numpy as np
-from numba import njit
 
 from . import Term
+from ..jit import kernel
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_pair_springs(x, acc, inv_mass, k, rest, stride, closed):
     """Add the accelerations [m/s^2] of the springs (i, i + stride) to ``acc``."""
     dim, n = x.shape
@@ -42,7 +42,7 @@ def add_pair_springs(x, acc, inv_mass, k, rest, stride, closed):
             acc[d, j] -= fd * mj
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def _spring_scale(k, rest, r2, slack):
     """k (1 - l0 / r) for a spring of squared length r2: times the separation, its force [N]; 0 if r = 0, and
     0 for a ``slack`` (tension-only) spring shorter than l0."""
@@ -52,7 +52,7 @@ def _spring_scale(k, rest, r2, slack):
     return c
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def set_chain_springs(x, acc, inv_mass, k, rest, closed, g, slack):
     """Overwrite ``acc`` with the accelerations [m/s^2] of the rope's springs (i, i + 1), minus ``g`` along y.
 
@@ -170,7 +170,7 @@ def segment_forces(model, x, v) -> np.ndarray:
     return _by_blocks(force, np.concatenate([np.asarray(x), np.asarray(v)], axis=-1))
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def add_axial_damping(x, v, acc, inv_mass, c, closed):
     """Add the segments' axial damping c (r_hat . dv) r_hat [N] / m; returns its power [W] (never positive)."""
     dim, n = x.shape

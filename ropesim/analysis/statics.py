@@ -1,0 +1,88 @@
+"""A scene's static shape and what an engineer reads from it: support forces, tensions, the length on the seabed.
+
+:func:`equilibrium` solves the shape with :mod:`ropesim.model.statics` (every force balanced at every free node:
+weight, buoyancy, springs, bending, the seabed's contact, drag in the flow at its full strength) from the
+scene's initial shape, the held nodes where the scene holds them at t = 0, and reports:
+
+- ``supports``: the force [N] each support exerts on its held node, minus the net force of the other terms
+  on it at rest (so a fairlead's is the line's pull on the vessel, reversed);
+- ``tension``: each segment's axial force [N] (spring and damping, zero in a slack segment);
+- with a ``[seabed]``: the nodes resting on it (sunk below its plane), the length of rope they carry, and the
+  touchdown point, the grounded node next to the suspended part.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..model.build import Model, build
+from ..model.statics import _steady_time, solve_equilibrium
+from ..scene import schema as S
+
+
+@dataclass(frozen=True)
+class StaticShape:
+    """The static shape of a scene and its figures (see the module doc); arrays in ropesim's frame layout."""
+
+    model: Model
+    x: np.ndarray               # (N, D) node positions [m]
+    residual: float             # the largest force left on a free node [N]
+    scale: float                # the largest force a term puts on a node [N]: the residual is relative to it
+    iterations: int
+    converged: bool
+    held: np.ndarray            # (H,) the held nodes
+    supports: np.ndarray        # (H, D) the force each support exerts on its node [N]
+    tension: np.ndarray         # (S,) each segment's tension [N]
+    grounded: np.ndarray        # indices of the nodes resting on the seabed (empty without one)
+    grounded_length: float      # the rope they carry [m]
+    touchdown: int | None       # the grounded node next to the suspended rope, or None
+
+
+def equilibrium(scene: S.Scene) -> StaticShape:
+    """Solve ``scene``'s static shape from its initial shape (an ``equilibrium`` start from its sagging guess)."""
+    model = build(scene, solve=False)
+    result = solve_equilibrium(model)
+    x = np.ascontiguousarray(result.x)
+    supports, tension = _loads(model, x)
+    grounded, length, touchdown = _on_the_seabed(model, x)
+    return StaticShape(model, x.T.copy(), result.residual, result.scale, result.iterations, result.converged,
+                       model.held_idx.copy(), supports, tension, grounded, length, touchdown)
+
+
+def _loads(model: Model, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    from ..model.forces.springs import segment_forces
+    from ..model.terms import accelerations
+
+    v, acc = np.zeros_like(x), np.zeros_like(x)
+    accelerations(x, v, acc, model.params, _steady_time(model.scene))
+    idx = model.held_idx
+    supports = -(model.mass[idx][:, None] * acc[:, idx].T)
+    tension = segment_forces(model, x.T[None], v.T[None])[0]
+    return supports, tension
+
+
+def _on_the_seabed(model: Model, x: np.ndarray) -> tuple[np.ndarray, float, int | None]:
+    bed = model.scene.seabed
+    if bed is None:
+        return np.zeros(0, dtype=int), 0.0, None
+    bed_x, area = model.params.seabed
+    sunk = (bed_x[0] + bed_x[1] * x[0] - x[1]) * bed_x[2]
+    grounded = np.flatnonzero(sunk > 0.0)
+    length = float(model.params.node_length[grounded].sum())
+    touchdown = None
+    if grounded.size and grounded.size < model.nodes:
+        lifted = sunk <= 0.0
+        ends = [i for i in grounded if (i > 0 and lifted[i - 1]) or (i < model.nodes - 1 and lifted[i + 1])]
+        touchdown = int(ends[-1]) if ends else None
+    return grounded, length, touchdown
+
+
+def as_points_scene(shape: StaticShape) -> S.Scene:
+    """The scene with its static shape as a ``points`` start, every node at rest but the driven ones: run it and
+    the dynamics begin without a transient. (An ``equilibrium`` start gives the same in one file; this writes
+    the shape out, to read or to edit.)"""
+    scene = shape.model.scene
+    points = tuple(tuple(float(c) for c in row) for row in shape.x)
+    return replace(scene, initial=S.PointsStart(points=points, velocity=(0.0,) * scene.dimension))
