@@ -112,8 +112,9 @@ class Seabed:
     A node that sinks a depth delta below the plane (measured along its normal n) feels k delta A along n,
     A = contact_width x L (its share of unstretched length), plus the damping c |v_n| A while it moves into the
     plane (none while it moves out: the seabed is not sticky), grown in over the first 1e-3 footprint widths
-    of depth (``damping_both_ways``: -c (v . n) A in both directions at full strength, as MoorDyn does); the contact stiffness k and damping c per unit area are MoorDyn's kBot and cBot (its defaults). Sliding on it, the
-    node feels Coulomb-like friction against its sliding velocity v_s (v minus its normal part), split along
+    of depth (``damping_both_ways``: -c (v . n) A in both directions at full strength, as MoorDyn does); the
+    contact stiffness k and damping c per unit area are MoorDyn's kBot and cBot (its defaults). Sliding on it,
+    the node feels Coulomb-like friction against its sliding velocity v_s (v minus its normal part), split along
     and across the rope (the node tangent projected on the plane):
 
         F = -N (mu_axial v_axial + mu v_across) / sqrt(|v_s|^2 + v_reg^2),   N = k delta A,
