@@ -26,16 +26,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path[:0] = [str(ROOT), str(ROOT / "tests")]   # this checkout's ropesim, not an installed one
 
 from references.moordyn_own_cases import (  # noqa: E402
     BEAM,
@@ -165,6 +163,7 @@ def chain_results(name: str, arrays: dict, record: dict) -> dict:
         traj = run_chain(case, start, method="rk4", dt=dt / k)
         runs[k] = (fairlead_tension(case, traj), anchor_tension(traj), float(traj.summary["wall_time_s"]))
     nofric = run_chain(case, start, method="rk4", dt=dt, friction=False)
+    one_way = run_chain(case, start, method="rk4", dt=dt, both_ways=False)   # ropesim's own seabed damping
     fair_rs, anch_rs, wall = runs[1]
     conv_fair, conv_anch = arrays[f"{name}_converged_fairlead"], arrays[f"{name}_converged_anchor"]
     out["dynamic"] = {
@@ -176,6 +175,8 @@ def chain_results(name: str, arrays: dict, record: dict) -> dict:
         "md_rk2": differences(conv_fair, arrays[f"{name}_rk2_fairlead_from_state"]),
         "md_reported": differences(conv_fair, ref["fairlead_tension"]),
         "friction": differences(fair_rs, fairlead_tension(case, nofric)),
+        "one_way_fair": differences(ref["fairlead_tension"], fairlead_tension(case, one_way)),
+        "one_way_anchor": differences(ref["anchor_tension"], anchor_tension(one_way)),
         "series": (ref["t"], ref["fairlead_tension"], fair_rs),
     }
     return out
@@ -245,14 +246,17 @@ def dynamic_table(chains: list[dict], beam: dict | None) -> str:
 
 def explanation_table(chains: list[dict]) -> str:
     rows = ["| case | ropesim rk4 at dt, dt/2, dt/4, dt/8 − MoorDyn converged (fairlead, RMS / range) | "
-            "anchor at dt | MoorDyn RK2 at dtM − converged | MoorDyn reported − from its state | friction's effect |",
-            "| --- | --- | --- | --- | --- | --- |"]
+            "anchor at dt | MoorDyn RK2 at dtM − converged | MoorDyn reported − from its state | friction's effect | "
+            "ropesim's one-way seabed damping − MoorDyn: fairlead RMS (max), anchor RMS |",
+            "| --- | --- | --- | --- | --- | --- | --- |"]
     for r in chains:
         d = r["dynamic"]
         ladder = ", ".join(rel(d["ladder"][k]["rms_of_range"]) for k in (1, 2, 4, 8))
         rows.append(f"| {r['case'].name} (dt = {d['dt'] * 1e3:.4g} ms) | {ladder} | "
                     f"{rel(d['ladder_anchor'][1]['rms_of_range'])} | {rel(d['md_rk2']['rms_of_range'])} | "
-                    f"{rel(d['md_reported']['rms_of_range'])} | {rel(d['friction']['rms_of_range'])} |")
+                    f"{rel(d['md_reported']['rms_of_range'])} | {rel(d['friction']['rms_of_range'])} | "
+                    f"{rel(d['one_way_fair']['rms_of_range'])} ({rel(d['one_way_fair']['max_of_range'])}), "
+                    f"{rel(d['one_way_anchor']['rms_of_range'])} |")
     return "\n".join(rows)
 
 
@@ -299,15 +303,10 @@ def draw(chains: list[dict], beam: dict | None, path: Path) -> None:
         bottom.set_xlabel("t [s]")
         for ax in (top, bottom):
             ax.grid(True, alpha=0.3)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
+    from ropesim.io.atomic import atomic_output
+
+    with atomic_output(path) as tmp:
         fig.savefig(tmp, format="png", dpi=100)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    finally:
-        Path(tmp).unlink(missing_ok=True)
     plt.close(fig)
 
 

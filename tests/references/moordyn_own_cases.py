@@ -207,8 +207,8 @@ class ChainCase:
 @dataclass(frozen=True)
 class Surge:
     """A smooth surge of the fairlead, ropesim's ``[[driven]]`` sinusoid: x(t) = x0 + r(t) A sin(2 pi t / T) along
-    x, r(t) = (1 - cos(pi t / ramp_time)) / 2 until ramp_time, then 1. amplitude A (m), period T (s), ramp_time
-    (s)."""
+    x, r(t) ropesim's smootherstep ramp (10 u^3 - 15 u^4 + 6 u^5, u = t / ramp_time) until ramp_time, then 1.
+    amplitude A (m), period T (s), ramp_time (s)."""
 
     amplitude: float
     period: float
@@ -222,7 +222,8 @@ class Surge:
             if self.ramp_time <= 0.0 or t >= self.ramp_time:
                 r = 1.0
             else:
-                r = 0.5 * (1.0 - math.cos(math.pi * max(t, 0.0) / self.ramp_time))
+                u = max(t, 0.0) / self.ramp_time
+                r = u * u * u * (10.0 + u * (-15.0 + 6.0 * u))
             x = x0.copy()
             x[0] += r * self.amplitude * math.sin(2.0 * math.pi * t / self.period)
             return x
@@ -278,14 +279,16 @@ def path_rows(case: ChainCase, t_end: float | None = None) -> list[list[float]]:
 
 def chain_scene_dict(case: ChainCase, start=None, method: str = "rk4", dt: float | None = None,
                      t_end: float | None = None, moving: bool = True, interval: float | None = None,
-                     friction: bool = True, dimension: int = 2, surge: Surge | None = None) -> dict:
+                     friction: bool = True, dimension: int = 2, surge: Surge | None = None,
+                     both_ways: bool = True) -> dict:
     """ropesim's scene (a TOML-ready dict) for a chain case.
 
     start: MoorDyn node positions (N+1, 3) as an ``initial.shape = "points"`` start at rest, or None for
     ropesim's own static shape (``initial.shape = "equilibrium"``); moving: the fairlead follows the stored path
     (:func:`path_rows`) until t_end, or with ``surge`` that smooth surge (ropesim's own sinusoid, exact at every
     stage), else it is pinned at rest; friction: MoorDyn's (see the module docstring) or none; dimension: 2 (the
-    x-z plane) or 3 (MoorDyn's (x, y, z) as ropesim's (x, z, y))."""
+    x-z plane) or 3 (MoorDyn's (x, y, z) as ropesim's (x, z, y)); both_ways: the seabed damps as MoorDyn's
+    cBot does (``damping_both_ways``), else with ropesim's own one-way law."""
     if dimension == 2:
         conv = to_ropesim
     else:
@@ -311,7 +314,8 @@ def chain_scene_dict(case: ChainCase, start=None, method: str = "rk4", dt: float
         "fluid_drag": {"cd_normal": case.Cd, "cd_tangential": case.CdAx},
         "added_mass": {"ca_normal": case.Ca, "ca_tangential": case.CaAx},
         "seabed": {"height": -case.depth, "stiffness": case.kbot, "damping": case.cbot,
-                   "friction": case.friction if friction else 0.0, "friction_speed": case.friction_speed},
+                   "friction": case.friction if friction else 0.0, "friction_speed": case.friction_speed,
+                   "damping_both_ways": both_ways},
         "pinned": {"nodes": [0] if moving else [0, -1]},
     }
     if moving and surge is not None:
@@ -732,8 +736,10 @@ def run_moordyn_line(case: ChainCase, start, motion, dtM: float, scheme: str, t_
     :func:`set_line_state`, no IC), the fairlead following ``motion`` (t -> MoorDyn position), handed to MoorDyn
     every ``coupling`` seconds (default dtM: one internal step per ``Step``, so its fairlead's piecewise-linear path
     follows the motion as closely as MoorDyn can) as the harness does. Returns {"t" (F,), "fairlead" (F,): its
-    reported ``GetLineFairTen`` every dt_out, "wall": the Step calls' wall time (s), "calls", "ok": False if a
-    tension came out non-finite}."""
+    reported ``GetLineFairTen`` every dt_out (from its last force evaluation, a fraction of a step before the
+    frame), "from_state" (F,): the top segment's |T + Td| from the state at the frame (the fairlead's velocity that
+    of the last Step), "wall": the Step calls' wall time (s), "calls", "ok": False if a tension came out
+    non-finite}."""
     from .moordyn_harness import moordyn_system, quiet_fd
 
     coupling = dtM if coupling is None else coupling
@@ -741,11 +747,20 @@ def run_moordyn_line(case: ChainCase, start, motion, dtM: float, scheme: str, t_
     steps = int(round(t_end / coupling))
     if abs(every * coupling - dt_out) > 1e-12 or abs(steps * coupling - t_end) > 1e-9:
         raise ValueError("the coupling step must divide dt_out and t_end")
-    out, wall, ok = [], 0.0, True
+    out, state, wall, ok = [], [], 0.0, True
+    n, l0 = case.segments, case.segment_length
     with moordyn_system(moordyn_line_text(case, dtM, scheme), motion(0.0), ic=False) as (md, system):
         line = md.GetLine(system, 1)
         set_line_state(md, system, line, start)
+
+        def from_state(fair_v) -> float:
+            seg = np.asarray(md.GetLineNodePos(line, n)) - np.asarray(md.GetLineNodePos(line, n - 1))
+            ls = float(np.linalg.norm(seg))
+            rate = float(seg @ (fair_v - np.asarray(md.GetLineNodeVel(line, n - 1)))) / ls
+            return abs(case.EA * max(ls - l0, 0.0) / l0 + case.BA * rate / l0)
+
         out.append(md.GetLineFairTen(line))
+        state.append(from_state(np.zeros(3)))
         with quiet_fd():
             xa = np.asarray(motion(0.0), dtype=float)
             for k in range(steps):
@@ -758,7 +773,9 @@ def run_moordyn_line(case: ChainCase, start, motion, dtM: float, scheme: str, t_
                 if (k + 1) % every == 0:
                     tension = md.GetLineFairTen(line)
                     out.append(tension)
+                    state.append(from_state(np.asarray(v)))
                     if forces is None or not np.all(np.isfinite(forces)) or not tension < 1e12:
                         ok = False
                         break
-    return {"t": dt_out * np.arange(len(out)), "fairlead": np.array(out), "wall": wall, "calls": steps, "ok": ok}
+    return {"t": dt_out * np.arange(len(out)), "fairlead": np.array(out), "from_state": np.array(state), "wall": wall,
+            "calls": steps, "ok": ok}
