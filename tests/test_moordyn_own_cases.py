@@ -317,3 +317,23 @@ def test_the_comparison_script_runs(tmp_path):
     assert "| BeamCantilevered | tip deflection" in result.stdout
     assert "| BeamCantilevered | tip height after a straight release |" in result.stdout
     assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.slow
+def test_the_speed_benchmark_runs(tmp_path):
+    """scripts/bench_moorings.py on a 4 s window without the EA sweep (needs MoorDyn): every method timed against
+    its code's converged answer, its tables, JSON and figure; MoorDyn's state set to ropesim's static shape."""
+    pytest.importorskip("moordyn")
+    out, figure = tmp_path / "speed.json", tmp_path / "speed.png"
+    result = subprocess.run([sys.executable, str(ROOT / "scripts" / "bench_moorings.py"), "--window", "4",
+                             "--repeats", "1", "--points", "2", "--no-sweep", "--json", str(out),
+                             "--figure", str(figure)], capture_output=True, text=True, timeout=900)
+    assert result.returncode == 0, result.stderr
+    assert "## Cheapest configuration per accuracy" in result.stdout
+    record = json.loads(out.read_text())
+    codes = {(r["code"], r["method"]) for r in record["rows"] if r["ok"]}
+    assert codes == {("ropesim", "verlet"), ("ropesim", "rk4"), ("ropesim", "sdirk2"), ("MoorDyn", "RK2"),
+                     ("MoorDyn", "RK4")}
+    assert record["case"]["seabed_damping_both_ways"] is True
+    assert record["converged_answers_apart_rms_of_range"] < 1e-3   # equal physics: the two answers agree
+    assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
