@@ -5,7 +5,7 @@ tests/references/moordyn_own_cases.py builds each case for ropesim from MoorDyn'
 conventions (friction, the fairlead's velocity jumps, the beam's straight start). Compared:
 
 - static: ropesim's static solve (``initial.shape = "equilibrium"``) and the end of a settled dynamic run (from a
-  straight line between the ends, every segment slack, 600 s of sdirk2 at 12.5 ms with the fairlead held) against
+  straight line between the ends, every segment slack, 600 s of sdirk2 at 6.25 ms with the fairlead held) against
   MoorDyn's IC state as its file sets it up (stored) and run tight (its stationary solver to threshIC 1e-6, stored
   in tests/data/moordyn/own_cases.json); for the beam the tip deflection against Euler-Bernoulli and against the
   deflection MoorDyn's release oscillates about;
@@ -13,13 +13,14 @@ conventions (friction, the fairlead's velocity jumps, the beam's straight start)
   at the same step from MoorDyn's IC state, along the same path: the fairlead tension (MoorDyn's ``GetLineFairTen``
   definition, see the module) and the anchor tension; for the beam the tip's height after a straight release;
 - where the difference comes from: both codes against MoorDyn's converged answer (RK4 at dtM/2, stored), ropesim's
-  step halved three times, friction off, MoorDyn's reported tension against the one from its state.
+  step halved three times, friction off, ropesim's own (one-way) seabed damping instead of MoorDyn's two-way law
+  (``seabed.damping_both_ways``, which the cases set), MoorDyn's reported tension against the one from its state.
 
     pip install -e ".[test]"     # moordyn, scipy
     python scripts/compare_moordyn_cases.py [--cases WD0050_Chain,...,BeamCantilevered] [--figure PATH]
     python scripts/compare_moordyn_cases.py --regenerate      # rerun MoorDyn for tests/data/moordyn/own_cases.*
 
-About 5 minutes on a shared 2-core machine; --regenerate adds about 5 minutes of MoorDyn runs.
+About 8 minutes on a shared 2-core machine at load 4 to 6; --regenerate adds about 5 minutes of MoorDyn runs.
 """
 
 from __future__ import annotations
