@@ -36,7 +36,7 @@ window, each method's cheapest configuration reaching 1 % and 0.1 % against an r
     python scripts/bench_moorings.py [--repeats 3] [--window 120] [--points 4] [--no-sweep] \\
         [--json docs/data/moorings_speed.json] [--figure docs/images/moorings_speed.png]
 
-About 13 minutes on a shared 2-core machine at load average 4 to 6 (6 without the sweep).
+About 6 minutes on the shared 2-core machine at load average 1 to 2, 13 at load 4 to 6 (half without the sweep).
 """
 
 from __future__ import annotations
