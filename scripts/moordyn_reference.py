@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path[:0] = [str(ROOT), str(ROOT / "tests")]   # this checkout's ropesim, not an installed one
 
 from references.catenary_closed_form import seabed_catenary  # noqa: E402
 from references.moordyn_harness import (  # noqa: E402
@@ -90,7 +90,7 @@ CASES = {
     "BeamCantilevered": Case(
         "BeamCantilevered.txt", "tests/Mooring/BeamCantilevered.txt", "0243ffbe11fbe757c3bc80e975f9cf29e07d403c",
         rest=None, amplitude=0.0, period=0.0, t_end=6.0, dt_out=0.005, ic=False,
-        note="no coupled point: the dynamic run releases the beam, straight and at rest (Init_NoIC), under gravity",
+        note="no coupled point: the dynamic run releases the beam at rest from MoorDyn's initial shape (Init_NoIC: its catenary between the end points, sagging 6.7 cm), under gravity",
     ),
 }
 

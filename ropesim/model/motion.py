@@ -81,9 +81,15 @@ def offset(m, j, d, t):
         dds = -a * w * w * math.sin(arg)
     lo, hi = m.span[j, 0], m.span[j, 1]
     if hi > lo:
-        k = lo
-        while k + 2 < hi and m.path_t[k + 1] <= t:
-            k += 1
+        # the row k that starts t's piece: the last of rows lo+1 .. hi-2 at or before t, else lo (a binary
+        # search: a sea state's path has 10^5 rows and every stage of every step looks one up)
+        k, top = lo, hi - 2
+        while k < top:
+            mid = (k + top + 1) // 2
+            if m.path_t[mid] <= t:
+                k = mid
+            else:
+                top = mid - 1
         t0, t1 = m.path_t[k], m.path_t[k + 1]
         slope = (m.path_d[d, k + 1] - m.path_d[d, k]) / (t1 - t0)
         s += m.path_d[d, k] + slope * (t - t0)

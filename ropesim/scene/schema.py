@@ -112,8 +112,9 @@ class Seabed:
     A node that sinks a depth delta below the plane (measured along its normal n) feels k delta A along n,
     A = contact_width x L (its share of unstretched length), plus the damping c |v_n| A while it moves into the
     plane (none while it moves out: the seabed is not sticky), grown in over the first 1e-3 footprint widths
-    of depth; the contact stiffness k and damping c per unit area are MoorDyn's kBot and cBot (its defaults). Sliding on it, the
-    node feels Coulomb-like friction against its sliding velocity v_s (v minus its normal part), split along
+    of depth (``damping_both_ways``: -c (v . n) A in both directions at full strength, as MoorDyn does); the
+    contact stiffness k and damping c per unit area are MoorDyn's kBot and cBot (its defaults). Sliding on it,
+    the node feels Coulomb-like friction against its sliding velocity v_s (v minus its normal part), split along
     and across the rope (the node tangent projected on the plane):
 
         F = -N (mu_axial v_axial + mu v_across) / sqrt(|v_s|^2 + v_reg^2),   N = k delta A,
@@ -137,6 +138,9 @@ class Seabed:
                                  default=0.01, low=0, open_low=True)
     contact_width: float | None = spec("float", "width of a node's footprint (default: the rope's diameter)", "m",
                                        default=None, required=False, low=0, open_low=True)
+    damping_both_ways: bool = spec("bool", "damp motion out of the plane too, at full strength from first contact "
+                                           "(MoorDyn's cBot, a sticky seabed; for comparisons with MoorDyn)",
+                                   default=False)
 
 
 @dataclass(frozen=True)

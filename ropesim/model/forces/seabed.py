@@ -13,7 +13,9 @@ delta = -s. On its footprint A = contact_width x L (L its share of unstretched l
   grows it over the first delta_d = 1e-3 times the footprint's width of penetration (0.1 mm for a 10 cm
   chain, less than what it sinks under its own weight), so that the contact force has no jump where a moving
   node touches the plane. Both choices keep the normal force continuous and growing with depth, which the
-  stiff method's Newton solve needs (a force that jumps may leave a stage equation without a root);
+  stiff method's Newton solve needs (a force that jumps may leave a stage equation without a root). With
+  ``damping_both_ways`` (for equal physics with MoorDyn) the damping is MoorDyn's instead: -c (v . n) A along
+  n, in both directions, at full strength from the first contact;
 - friction against its sliding velocity v_s = v - (v . n) n, split along the rope (the node tangent projected
   on the plane, t_s) and across it: F = -N (mu_axial (v_s . t_s) t_s + mu (v_s - (v_s . t_s) t_s)) /
   sqrt(|v_s|^2 + v_reg^2), N = k delta A the spring's normal load. Well above v_reg (``friction_speed``) this
@@ -22,8 +24,8 @@ delta = -s. On its footprint A = contact_width x L (L its share of unstretched l
 
 The damping and friction depend on velocity; their work is the energy ledger's ``seabed_work``.
 
-Parameters: ``seabed`` = (scalars [height, tan a, cos a, sin a, k, c, mu, mu_axial, v_reg, delta_d],
-footprint (N,) [m^2]).
+Parameters: ``seabed`` = (scalars [height, tan a, cos a, sin a, k, c, mu, mu_axial, v_reg, delta_d,
+both ways (1) or into the plane only (0)], footprint (N,) [m^2]).
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ from .fluid import node_tangent
 from .. import jit
 
 SEABED = 12   # its flag
-SEABED_PARAMS = 10
+SEABED_PARAMS = 11
 DAMPING_DEPTH = 1e-3   # delta_d / the footprint's width: the depth over which the contact damping grows
 
 
@@ -75,7 +77,10 @@ def add_seabed_friction(x, v, acc, inv_mass, seabed, closed):
             continue
         vz = v[2, i] if dim == 3 else 0.0
         vn = v[0, i] * nx + v[1, i] * ny
-        damp = c * area[i] * min(1.0, sunk / bed[9]) * min(vn, 0.0)   # resists motion into the plane only
+        if bed[10] > 0.0:
+            damp = c * area[i] * vn   # MoorDyn's: both ways, at full strength
+        else:
+            damp = c * area[i] * min(1.0, sunk / bed[9]) * min(vn, 0.0)   # resists motion into the plane only
         fx = -damp * nx
         fy = -damp * ny
         fz = 0.0
@@ -134,7 +139,9 @@ def add_seabed_jacobian(x, v, band, beta, free, seabed, friction):
             continue
         vn = v[0, i] * normal[0] + v[1, i] * normal[1]
         along_n = beta * beta * bed[4] * area[i]
-        if vn < 0.0:
+        if bed[10] > 0.0:
+            along_n += beta * bed[5] * area[i]
+        elif vn < 0.0:
             along_n += beta * bed[5] * area[i] * min(1.0, sunk / bed[9])
             if sunk < bed[9]:
                 along_n -= beta * beta * bed[5] * area[i] * vn / bed[9]
@@ -155,7 +162,7 @@ def _params(scene, layout) -> tuple:
     width = bed.contact_width if bed.contact_width is not None else scene.rope.diameter
     scalars = np.array([bed.height, math.tan(a), math.cos(a), math.sin(a), bed.stiffness, bed.damping, bed.friction,
                         bed.friction if bed.friction_axial is None else bed.friction_axial, bed.friction_speed,
-                        DAMPING_DEPTH * width])
+                        DAMPING_DEPTH * width, 1.0 if bed.damping_both_ways else 0.0])
     return scalars, width * layout.node_length
 
 
