@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from ..integrate.health import LEDGER_COLUMNS
-from .runfolder import (CHECKPOINT, FINISHED, INCOMPLETE, INTERRUPTED, LEDGER, SUMMARY, TRAJECTORY, RunFolderError,
-                        holder, memmap_npz, open_stream_array, read_manifest)
+from .runfolder import (CHECKPOINT, FINISHED, INCOMPLETE, INTERRUPTED, LEDGER, SCENE, SUMMARY, TRAJECTORY,
+                        RunFolderError, holder, memmap_npz, open_stream_array, read_manifest)
 
 
 class Moved(Exception):
@@ -86,9 +86,18 @@ def read_flows(folder: Path) -> tuple[np.ndarray, float] | None:
                 float(npz["energy0"]))
 
 
+def check_run_folder(folder: Path) -> None:
+    """Raise :class:`RunFolderError` with one line unless ``folder`` is a folder holding a run's scene.toml."""
+    if not folder.is_dir():
+        raise RunFolderError(f"{folder}: no such run folder (make one with `ropesim run SCENE.toml`)")
+    if not (folder / SCENE).is_file():
+        raise RunFolderError(f"{folder}: not a run folder: {SCENE} is missing")
+
+
 def read_run(folder: Path, verify: bool = True):
     """(named arrays, ledger (F, C) or None, summary) of a run folder, finished or not; a run that commits a
     checkpoint while it is read is read again from its new manifest."""
+    check_run_folder(folder)
     for attempt in range(3):
         try:
             return read_frames(folder, read_manifest(folder), verify)

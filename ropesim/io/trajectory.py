@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .frames import Moved, read_frames
-from .runfolder import SCENE, TRAJECTORY, RunFolderError, read_manifest
+from .frames import check_run_folder, read_run
+from .runfolder import SCENE, TRAJECTORY, RunFolderError
 
 ARRAYS = ("t", "x", "v")
 DERIVED = ("tension", "strain", "support")   # per frame, derived from t, x and v as they are stored
@@ -116,22 +116,12 @@ class Trajectory:
         from ..scene.loader import SceneError, load_scene
 
         folder = Path(folder)
-        if not folder.is_dir():
-            raise RunFolderError(f"{folder}: no such run folder (make one with `ropesim run SCENE.toml`)")
-        for attempt in range(3):
-            manifest = read_manifest(folder)
-            if not (folder / SCENE).is_file():
-                raise RunFolderError(f"{folder}: not a run folder: {SCENE} is missing")
-            try:
-                scene = load_scene(folder / SCENE)
-            except SceneError as exc:
-                raise RunFolderError(f"{folder}: its scene.toml is not valid: {exc}") from None
-            try:
-                arrays, ledger, summary = read_frames(folder, manifest, verify)
-                break
-            except Moved:       # the run committed (or finished) while we read: read the new manifest
-                if attempt == 2:
-                    raise RunFolderError(f"{folder}: changes too fast to read (a run is finishing there)") from None
+        check_run_folder(folder)
+        try:
+            scene = load_scene(folder / SCENE)
+        except SceneError as exc:
+            raise RunFolderError(f"{folder}: its scene.toml is not valid: {exc}") from None
+        arrays, ledger, summary = read_run(folder, verify)
         missing = [a for a in ARRAYS if a not in arrays]
         if missing:
             raise RunFolderError(f"{folder / TRAJECTORY}: missing arrays {', '.join(missing)}")

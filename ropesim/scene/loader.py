@@ -542,8 +542,6 @@ def _read_start(scene: S.Scene, base_dir: Path, fail) -> S.Scene:
     folder = Path(init.run)
     folder = folder if folder.is_absolute() else base_dir / folder
     try:
-        if not folder.is_dir():
-            raise RunFolderError(f"{folder}: no such run folder (make one with `ropesim run SCENE.toml`)")
         arrays = read_run(folder)[0]
     except RunFolderError as exc:
         fail("initial.run", f"cannot start from it: {exc}")
