@@ -115,9 +115,10 @@ def any_fluid(flags):
             or flags[FLOW_PUSH] != 0)
 
 
-@jit.kernel
+@jit.kernel(inline="always")
 def position_accelerations(x, acc, p):
-    """Overwrite ``acc`` (D, N) with the acceleration [m/s^2] of the terms that depend on positions alone."""
+    """Overwrite ``acc`` (D, N) with the acceleration [m/s^2] of the terms that depend on positions alone.
+    Inlined into its callers: a call hands over the whole parameter bundle, which cost rk4 10 % on 21 nodes."""
     closed = p.spring[2] != 0.0
     g = p.gravity[0] if p.flags[GRAVITY] else 0.0
     set_chain_springs(x, acc, p.inv_mass, p.spring[0], p.spring[1], closed, g, p.spring[3] != 0.0)
@@ -156,12 +157,21 @@ def velocity_accelerations(x, v, acc, p, t):
     return fluid, internal, seabed
 
 
+@jit.kernel(inline="always")
+def any_velocity_term(flags):
+    """True when a term that depends on velocities or time (see :func:`velocity_accelerations`) is on."""
+    return (flags[THROWER] != 0 or flags[GUIDES] != 0 or flags[AXIAL_DAMPING] != 0 or any_fluid(flags)
+            or flags[FLOW_INERTIA] != 0 or flags[SEABED] != 0)
+
+
 @jit.kernel
 def accelerations(x, v, acc, p, t):
     """Overwrite ``acc`` (D, N) with every term's force / m [m/s^2] at time t [s], the linear [drag] b v and
     added mass excluded; returns the power [W] of the fluid, the axial damping and the seabed."""
     position_accelerations(x, acc, p)
-    return velocity_accelerations(x, v, acc, p, t)
+    if any_velocity_term(p.flags):   # else skip the call: handing over the parameter bundle costs more than a
+        return velocity_accelerations(x, v, acc, p, t)   # small rope's spring pass (rk4: 20 % on 21 nodes)
+    return 0.0, 0.0, 0.0
 
 
 @jit.kernel
