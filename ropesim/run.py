@@ -1,6 +1,6 @@
 """Run a scene: an integrator in chunks, frames streamed out, progress, Ctrl-C and blow-up stops.
 
-Between chunks (each about a tenth of a second of work) control returns to Python: saved frames go to their
+Between chunks (each about a tenth of a second of wall time, measured, whatever a step costs) control returns to Python: saved frames go to their
 store, the progress bar moves, and an interrupt or a blow-up ends the run cleanly with every frame computed
 so far kept. Chunking never changes the numbers: the same scene gives bit-identical frames however it is cut.
 The integrator comes from one table by the scene's method name (:mod:`ropesim.integrate.methods`); this
@@ -22,7 +22,7 @@ import numpy as np
 from .integrate.grid import TimeGrid
 from .integrate.health import E0, LEDGER_COLUMNS, NEWTON_FAILED, NON_FINITE, OK, OVERSTRETCH, RUNAWAY_ENERGY
 from .integrate.health import RUNAWAY_FLOW_FRACTION
-from .integrate.base import Integrator
+from .integrate.base import ChunkSizer, Integrator
 from .integrate.methods import make_integrator
 from .model.build import Model, build
 from .scene.schema import Scene
@@ -112,8 +112,7 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
             if on_chunk is not None:
                 on_chunk(integrator, 0.0)
         status, bad_node, message, code = "completed", -1, "", OK
-        chunk = max(1, min(grid.steps, 20_000_000 // max(1, model.nodes * integrator.method.evaluations)))
-        chunk = _round_to(chunk, grid.save_every)
+        chunks = ChunkSizer(target_chunk_seconds, grid.save_every)
         frame_cap = grid.save_every * max(1, FRAME_BUFFER_BYTES // (2 * 8 * model.nodes * model.dim))
         compile_time = integrator.warm_up()
         start = time.perf_counter()
@@ -122,11 +121,11 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
                 status = INTERRUPTED
                 message = f"interrupted at t = {integrator.t:.6g} s (step {integrator.step} of {grid.steps})"
                 break
-            n = min(chunk, frame_cap, grid.steps - integrator.step)
+            n = min(chunks.steps, frame_cap, grid.steps - integrator.step)
             frames = integrator.new_frames(n)
             tick = time.perf_counter()
             done, written, code, node = integrator.advance(n, frames)
-            elapsed = time.perf_counter() - tick
+            chunks.measured(done, time.perf_counter() - tick)
             store.append(frames[0][:written], frames[1][:written], frames[2][:written], frames[3][:written])
             if code != OK:
                 status, bad_node = BLEW_UP, node
@@ -135,9 +134,6 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
                 on_chunk(integrator, time.perf_counter() - start)
             if on_progress is not None:
                 on_progress(integrator.t, scene.integrator.t_end)
-            if elapsed > 0:
-                rate = done / elapsed
-                chunk = _round_to(max(1, int(rate * target_chunk_seconds)), grid.save_every)
         if hasattr(store, "drain"):
             store.drain()       # the frames still being written count in the run's wall time
     wall = time.perf_counter() - start
@@ -182,11 +178,6 @@ def _blow_up_message(model: Model, integrator: Integrator, code: int, node: int)
         stable_dt = 0.25 * grid.dt
     return stable_dt, (f"blew up at t = {integrator.t:.6g} s (step {integrator.step}): {what}, with dt = {grid.dt:.3g} s and "
                        f"method {method}; a time step of {stable_dt:.3g} s or less would be stable")
-
-
-def _round_to(n: int, multiple: int) -> int:
-    """``n`` rounded to a positive multiple of ``multiple`` (so chunks end on saved frames)."""
-    return max(multiple, (n // multiple) * multiple)
 
 
 # Measured cost of the kernel per node and step [ns] (helicopter_mass at 21 and 201 nodes, the larger of the
