@@ -338,8 +338,7 @@ def _manifest_info(scene: Scene, grid: TimeGrid) -> dict:
 
 
 def _run_in_memory(model: Model, grid: TimeGrid, progress: bool, stop, before_bar=None) -> "Trajectory":
-    from .analysis.summary import summarize
-    from .io.trajectory import FrameStore, Trajectory
+    from .io.trajectory import FrameStore
     from .model.tension import frame_arrays
 
     specs = frame_specs(model)
@@ -347,9 +346,17 @@ def _run_in_memory(model: Model, grid: TimeGrid, progress: bool, stop, before_ba
                        shapes={k: s for k, s in specs.items() if k not in ("t", "x", "v", "ledger")})
     with _progress(progress, model.scene, before_bar) as on_progress:
         outcome = integrate(model, store, on_progress, stop=stop)
-    arrays = store.arrays()
+    return _in_memory(model, store.arrays(), outcome)
+
+
+def _in_memory(model: Model, arrays: dict, outcome: RunOutcome, **more) -> "Trajectory":
+    """A trajectory held in memory from the run's frame arrays, with its summary (and ``more`` in it)."""
+    from .analysis.summary import summarize
+    from .io.trajectory import Trajectory
+
     summary = summarize(model, outcome, arrays["t"], arrays["x"], arrays["v"], arrays["tension"])
     _stopped_by(summary, outcome)
+    summary.update(more)
     extra = {k: v for k, v in arrays.items() if k in ("tension", "strain", "support", "ledger")}
     return Trajectory(t=arrays["t"], x=arrays["x"], v=arrays["v"], scene=model.scene, summary=summary, **extra)
 
@@ -444,7 +451,6 @@ def _run_in_folder(model: Model, grid: TimeGrid, writer, integrator: Integrator 
     from .io.runfolder import LEDGER, TRAJECTORY
     from .io.trajectory import Trajectory
 
-    folder = writer.folder
     writer.expected_frames = grid.frames
     store = _DiskStore(writer, model, checkpoint_seconds, previous)
     try:
@@ -452,6 +458,8 @@ def _run_in_folder(model: Model, grid: TimeGrid, writer, integrator: Integrator 
             outcome = integrate(model, store, on_progress, stop=stop, integrator=integrator, interrupted=flag,
                                 on_chunk=store.on_chunk)
             store.compile_time = outcome.compile_time
+            if outcome.status == INTERRUPTED and writer.pending:
+                return _not_replaced(model, writer, store, outcome)
             store.checkpoint(outcome.integrator, outcome.wall_time)     # every stop is a checkpoint
             outcome.wall_time += store.wall0
             outcome.compile_time += store.compile0
@@ -467,7 +475,17 @@ def _run_in_folder(model: Model, grid: TimeGrid, writer, integrator: Integrator 
     finally:
         store.close()
         writer.close()
-    return Trajectory.open(folder, verify=False)
+    return Trajectory.open(writer.folder, verify=False)
+
+
+def _not_replaced(model: Model, writer, store, outcome: RunOutcome):
+    """A rerun stopped before its first checkpoint past t = 0: it is dropped and the earlier run in its folder
+    stays as it was; returns the stopped run's frames, in memory, its summary saying so."""
+    store.drain()
+    arrays = {name: np.array(a) for name, a in writer.arrays().items()}
+    folder = writer.discard()
+    outcome.message += f" before it replaced the earlier run in {folder}, which is kept as it was"
+    return _in_memory(model, arrays, outcome, kept_earlier_run=str(folder))
 
 
 @contextmanager

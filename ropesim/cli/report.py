@@ -125,10 +125,20 @@ def print_summary(summary: dict, folder: Path) -> None:
                                       f"{'flowed' if ledger['relative_to'] == 'flows' else 'moved'})"))
     if summary.get("message"):
         rows.append(("stopped", summary["message"]))
-    rows.append(("written", f"{folder}/ (trajectory.npz, scene.toml, summary.json)"))
+    rows.append(("written", written(summary, folder)))
     for key, value in rows:
         table.add_row(key, value)
     _console().print(table)
+
+
+def written(summary: dict, folder: Path) -> str:
+    """What the run left in its folder: the finished run's files, an interrupted run's checkpoint, or (a rerun
+    stopped before it replaced the earlier run) nothing."""
+    if summary.get("kept_earlier_run"):
+        return f"nothing: {folder}/ still holds the earlier run"
+    if summary["status"] == "interrupted":
+        return f"{folder}/ (frames in checkpoint/, scene.toml, summary.json; `ropesim run --resume {folder}` goes on)"
+    return f"{folder}/ (trajectory.npz, ledger.npz, scene.toml, summary.json)"
 
 
 def print_check(scene: Scene, source: Path) -> None:

@@ -20,7 +20,7 @@ from . import RenderError
 from .encode import ANIMATION_TYPES, GIF_MAX_FPS, gif_fps, write_gif, write_mp4
 from .framing import Projection, figure_inches, followed_nodes, origin, projection, single_view, view_box
 from ..io.atomic import atomic_output
-from .output import output_type
+from .output import output_path
 from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
 from .style import with_picture_text
 from .timeline import animation_plan
@@ -115,7 +115,7 @@ def animate(traj: Frames, out: str | Path, *, fps: float = 25.0, speed: float = 
     Raises :class:`ropesim.render.RenderError` for a request that cannot be met, before writing anything.
     """
     out = Path(out)
-    kind = output_type(out, ANIMATION_TYPES)
+    real, kind = output_path(out, ANIMATION_TYPES)
     if size < 128:
         raise RenderError(f"--size {size}: must be at least 128 px")
     remarks = []
@@ -136,7 +136,7 @@ def animate(traj: Frames, out: str | Path, *, fps: float = 25.0, speed: float = 
     renderer = FrameRenderer(traj, model, proj, nodes, size)
     frames = _tracked((renderer.render(i) for i in plan.indices), len(plan.indices), f"encoding {out.name}",
                       progress)
-    with atomic_output(out) as tmp:
+    with atomic_output(real) as tmp:
         if kind == ".gif":
             spread = plan.indices[np.linspace(0, len(plan.indices) - 1, PALETTE_SAMPLES).round().astype(int)]
             write_gif(frames, tmp, plan.fps, [renderer.render(i) for i in spread])
