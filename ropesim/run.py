@@ -266,6 +266,11 @@ def resume(folder: str | Path, t_end: float | None = None, progress: bool = Fals
     writer = RunWriter.reopen(folder)
     try:
         scene, old_t_end = _scene_to_continue(folder, writer.manifest, t_end)
+        reached = (writer.manifest.get("checkpoint") or {}).get("t")
+        if t_end is not None and reached is not None and t_end < reached:
+            raise RunFolderError(f"{folder}: integrator.t_end = {t_end:g} s lies before the run's last checkpoint "
+                                 f"(t = {reached:.6g} s), where it goes on from; give a t_end of at least "
+                                 f"{reached:.6g} s")
         model = build(scene)
         grid = TimeGrid.of(scene)
         old = writer.manifest.get("grid", {})

@@ -55,7 +55,30 @@ class Command(_CleanHelp, TyperCommand):
 
 
 class Group(_CleanHelp, TyperGroup):
-    pass
+    """Ctrl-C before a command's own clean stop (while it parses, loads, compiles or checks) is one line and
+    exit 130; Typer's own handling would exit 130 without a word."""
+
+    def make_context(self, *args, **kwargs):
+        with _interrupt_in_one_line():
+            return super().make_context(*args, **kwargs)
+
+    def invoke(self, ctx):
+        with _interrupt_in_one_line():
+            return super().invoke(ctx)
+
+
+class _interrupt_in_one_line:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        if kind is KeyboardInterrupt:
+            from .status import close_early
+
+            close_early()
+            typer.echo("ropesim: interrupted", err=True)
+            raise typer.Exit(130) from None
+        return False
 
 
 app = typer.Typer(
@@ -562,7 +585,9 @@ def _check_fps(fps: float) -> float:
     return fps
 
 
-MAX_FPS, SIZE_RANGE, WIDTH_RANGE, COLUMNS_RANGE, COUNT_RANGE = 1000, (32, 8192), (100, 16384), (1, 64), (1, 1000)
+from ..render import SIZE_RANGE  # noqa: E402
+
+MAX_FPS, WIDTH_RANGE, COLUMNS_RANGE, COUNT_RANGE = 1000, (100, 16384), (1, 64), (1, 1000)
 
 
 def _bounded(option: str, low: int, high: int, what: str):

@@ -23,6 +23,7 @@ from ..io.guard import SOFTWARE
 ANIMATION_TYPES = (".gif", ".mp4")
 GIF_MAX_FPS = 50.0  # viewers slow down GIFs with delays under 2/100 s
 PALETTE_SEPARATION = 9  # see gif_palette
+PALETTE_PIXELS = 1 << 20  # pixels of a sample frame the palette counts (a large frame's every k-th)
 MP4_QUALITY = 6     # imageio-ffmpeg's 0..10 scale (6 is x264's crf 20); thin lines need more than its default 5
 MP4_PRESET = "veryfast"  # x264 speed preset: at these sizes twice as fast as "medium", about as small
 
