@@ -212,6 +212,7 @@ def estimate(scene: Scene, model: Model | None = None) -> Estimate:
 
 
 CHECKPOINT_SECONDS = 5.0   # a run folder commits a checkpoint at most this often (and at every stop)
+LOW_DISK_BYTES = 64 * 2 ** 20   # below this much free space, every chunk is a checkpoint
 
 
 def frame_specs(model: Model) -> dict[str, tuple]:
@@ -438,8 +439,18 @@ class _DiskStore:
 
     def on_chunk(self, integrator: Integrator, wall: float) -> None:
         self._raise()
-        if time.monotonic() - self.last >= self.seconds:
+        if time.monotonic() - self.last >= self.seconds or self._disk_nearly_full():
             self.checkpoint(integrator, wall)
+
+    def _disk_nearly_full(self) -> bool:
+        """True when the run folder's disk has less than LOW_DISK_BYTES free: then every chunk is a checkpoint,
+        so a disk that fills up loses at most the last chunk (the frames of the others stay)."""
+        from .io.runfolder import free_bytes
+
+        try:
+            return free_bytes(self.writer.folder) < LOW_DISK_BYTES
+        except OSError:
+            return False
 
     def checkpoint(self, integrator: Integrator, wall: float) -> None:
         self.drain()

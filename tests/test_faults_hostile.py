@@ -477,3 +477,130 @@ def test_crafted_pickles_are_refused_in_one_line(tmp_path, run_folder, interrupt
         code, _, err = cli("check", str(scene))
         assert code == 2, err
         one_line(err)
+
+
+# ------------------------------------------------------------------------------------------ full disks
+
+
+def _tmpfs(path: Path, size: str) -> bool:
+    path.mkdir()
+    return subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(path)],
+                          capture_output=True).returncode == 0
+
+
+def test_run_force_on_a_disk_too_small_keeps_what_fitted(tmp_path):
+    """run --force into a 300 kB disk computed the whole run as one chunk and kept only t = 0; now every chunk
+    is a checkpoint on a nearly full disk, and what fitted stays."""
+    mnt = tmp_path / "mnt"
+    if not _tmpfs(mnt, "300k"):
+        pytest.skip("cannot mount a tmpfs here (needs root or a user namespace)")
+    try:
+        code, _, err = cli("run", str(SCENE), "--out", str(mnt / "run"), "--force", "-q",
+                           "--set", "integrator.t_end=100")
+        assert code == 4 and "the disk is full" in one_line(err)
+        traj = Trajectory.open(mnt / "run")
+        assert traj.frames > 50, traj.frames
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
+
+
+def test_sweep_into_a_full_disk_is_one_line_and_leaves_no_lock_only_folders(tmp_path):
+    mnt = tmp_path / "mnt"
+    if not _tmpfs(mnt, "100k"):
+        pytest.skip("cannot mount a tmpfs here (needs root or a user namespace)")
+    try:
+        code, _, err = cli("sweep", str(SCENE), "--set", "integrator.t_end=100", "--set", "drag.b=4,5,6",
+                           "--out", str(mnt / "sweep"), "--jobs", "1", "-q")
+        assert code in (3, 4), err
+        one_line(err)
+        for folder in (mnt / "sweep").iterdir() if (mnt / "sweep").exists() else ():
+            if folder.is_dir():
+                assert set(os.listdir(folder)) != {".lock"}, folder
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
+
+
+# --------------------------------------------------------------------------------- nesting and size bombs
+
+
+@pytest.mark.parametrize("bomb", ["table", "array", "description", "size"])
+def test_toml_bombs_are_one_line_and_exit_2(tmp_path, bomb):
+    scene = tmp_path / "bomb.toml"
+    if bomb == "table":
+        scene.write_text("a = " + "{b = " * 5000 + "1" + "}" * 5000 + "\n")
+    elif bomb == "array":
+        scene.write_text("a = " + "[" * 100_000 + "]" * 100_000 + "\n")
+    elif bomb == "description":
+        scene.write_text(f'description = "{"x" * 5_000_000}"\n' + SCENE.read_text().replace("description", "#"))
+    else:
+        scene.write_text("# " + "x" * (17 * 2 ** 20) + "\n" + SCENE.read_text())
+    started = time.monotonic()
+    code, _, err = cli("check", str(scene))
+    assert code == 2 and str(scene) in one_line(err)
+    assert time.monotonic() - started < 60
+
+
+def test_set_and_sweep_nesting_bombs_are_one_line(tmp_path):
+    deep = "[" * 5000 + "]" * 5000
+    for args in (["check", str(SCENE), "--set", f"rope.nodes={deep}"],
+                 ["sweep", str(SCENE), "--set", f"drag.b={deep}", "--out", str(tmp_path / "s")]):
+        code, _, err = cli(*args)
+        assert code == 2, err
+        one_line(err)
+
+
+def test_csv_bombs_are_one_line(tmp_path):
+    (tmp_path / "huge.csv").write_text("0,0,0\n" + "".join(f"{i},{i * 1e-3},0\n" for i in range(1, 100_002)))
+    (tmp_path / "far.csv").write_text("0,0,0\n1000,1e300,0\n")
+    for name, fragment in (("huge.csv", "more than 100,000 rows"), ("far.csv", "at most 1e+12")):
+        scene = tmp_path / f"{name}.toml"
+        scene.write_text(SCENE.read_text() + f'\n[[driven]]\nnodes = [3]\npath = "{name}"\n')
+        code, _, err = cli("check", str(scene))
+        assert code == 2 and fragment in one_line(err), err
+
+
+# ------------------------------------------------------------------------------------------------ sweeps
+
+
+def test_a_sweep_of_10_000_runs_stopped_by_ctrl_c(tmp_path):
+    """It left 9,919 empty run folders, listed the runs never started as "error" and reported "10000 runs
+    (10000 run now, 0 kept)"."""
+    out = tmp_path / "sweep"
+    proc = subprocess.Popen([sys.executable, "-m", "ropesim", "sweep", str(SCENE), "--set", "drag.b=1:10:100",
+                             "--set", "integrator.t_end=0.1:0.2:100", "--out", str(out), "--jobs", "1", "--yes"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 240
+    while time.time() < deadline and len(list(out.glob("*/summary.json"))) < 3 and proc.poll() is None:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    stdout, err = proc.communicate(timeout=240)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and err.splitlines()[0] == f"ropesim: sweep: 10,000 runs into {out}/"
+    from ropesim.sweep.core import read_table
+
+    rows = read_table(out / "results.csv")
+    assert len(rows) == 10_000
+    statuses = {s: sum(r["status"] == s for r in rows) for s in {r["status"] for r in rows}}
+    folders = [p for p in out.iterdir() if p.is_dir()]
+    ran = len(rows) - statuses["not_run"]
+    assert set(statuses) <= {"completed", "interrupted", "not_run"} and 3 <= ran < 100, statuses
+    assert len(folders) == ran                                 # no folder for a run that never started
+    assert f"({ran} run now, 0 kept, {statuses['not_run']} not started)" in stdout
+
+
+def test_a_large_sweep_asks_first(tmp_path):
+    code, _, err = cli("sweep", str(SCENE), "--set", "drag.b=1:10:2000", "--out", str(tmp_path / "s"))
+    assert code == 2 and "2,000 runs" in one_line(err) and "--yes" in err
+    assert not (tmp_path / "s").exists()
+    code, _, err = cli("sweep", str(SCENE), "--set", "drag.b=1:10:1000", "--set", "rope.nodes=3:1002:1000",
+                       "--out", str(tmp_path / "s"))
+    assert code == 2 and "1,000,000 combinations" in one_line(err)
+
+
+def test_sweep_plot_is_checked_before_the_runs(tmp_path):
+    out = tmp_path / "s"
+    code, _, err = cli("sweep", str(SCENE), "--set", "drag.b=4,5", "--set", "integrator.t_end=0.1",
+                       "--out", str(out), "--plot", "no.such_figure", "--jobs", "1")
+    assert code == 2 and "Traceback" not in err
+    assert err.strip().splitlines()[-1].startswith("ropesim: --plot no.such_figure: not a numeric column")
+    assert not out.exists() or not [p for p in out.iterdir() if p.is_dir()]       # no run started

@@ -187,7 +187,7 @@ def run_sweep(scene_file: str | Path, sets: list[str], out: str | Path | None = 
             result.stopped_by = exc.name if isinstance(exc, Stopped) else "SIGINT"
         finally:
             result.rows = [_final_row(p, folders[p.name], outcomes.get(p.name)) for p in points]
-            result.ran = len(outcomes)
+            result.ran = sum(r["status"] != NOT_RUN for r in result.rows) - len(done)
             root.mkdir(parents=True, exist_ok=True)
             write_table(result.rows, swept, result.csv_path)
     if not result.interrupted:
