@@ -85,7 +85,8 @@ def output_folder(path: str | Path, kind: str, option: str = "--out") -> Path:
         raise WriteRefused(f"{option} {shown}: exists and is not a folder")
     blocked = next((p for p in real.parents if p.exists() and not p.is_dir()), None)
     if blocked is not None:
-        raise WriteRefused(f"{option} {shown}: cannot write it: {blocked} is a file, not a folder")
+        what = {"run": "the run folder", "vtk": "the series", "sweep": "the sweep folder"}[kind]
+        raise WriteRefused(f"{option} {shown}: cannot write {what}: {blocked} is a file, not a folder")
     if real.is_dir():
         foreign = foreign_entries(real, kind)
         if foreign:
