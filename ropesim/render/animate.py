@@ -117,7 +117,7 @@ def animate(traj: Frames, out: str | Path, *, fps: float = 25.0, speed: float = 
     """
     out = Path(out)
     real, kind = output_path(out, ANIMATION_TYPES)
-    if not SIZE_RANGE[0] <= size <= SIZE_RANGE[1]:
+    if not 1 <= size <= SIZE_RANGE[1]:    # (the command line asks for at least SIZE_RANGE[0], what is drawn)
         raise RenderError(f"--size {size}: must be a number of pixels from {SIZE_RANGE[0]} to {SIZE_RANGE[1]}")
     remarks = []
     rate = fps

@@ -128,7 +128,7 @@ def run_sweep(scene_file: str | Path, sets: list[str], out: str | Path | None = 
     """
     from ..io.guard import WriteRefused, output_folder
     from .plan import parse_axes
-    from .progress import planning
+    from .progress import PLANNING_SHOWN, planning
 
     plots = list(plots)
     if jobs is not None and jobs < 1:
@@ -143,10 +143,12 @@ def run_sweep(scene_file: str | Path, sets: list[str], out: str | Path | None = 
     except WriteRefused as exc:
         raise SweepError(str(exc)) from None
     count = math.prod(len(a.values) for a in axes)
-    if before is not None:
+    if before is not None and count >= PLANNING_SHOWN:    # a large sweep is said (and asked) before it plans
         before(count, root)
     with planning(count, quiet) as on_point:
         base, axes, points = plan(scene_file, sets, on_point=on_point)
+    if before is not None and count < PLANNING_SHOWN:     # a small one once every combination is valid
+        before(count, root)
     swept = [a.key for a in axes if a.swept]
 
     folders = {p.name: root / p.name for p in points}   # each made by its run (none for runs never started)
