@@ -469,10 +469,11 @@ def _run_in_folder(model: Model, grid: TimeGrid, writer, integrator: Integrator 
 
     writer.expected_frames = grid.frames
     store = _DiskStore(writer, model, checkpoint_seconds, previous)
-    try:
-        with stop_signals() as flag, _progress(progress, model.scene, before_bar) as on_progress:
-            outcome = integrate(model, store, on_progress, stop=stop, integrator=integrator, interrupted=flag,
-                                on_chunk=store.on_chunk)
+    with stop_signals() as flag:   # until the folder is closed: a signal after the last chunk cannot tear that
+        try:
+            with _progress(progress, model.scene, before_bar) as on_progress:
+                outcome = integrate(model, store, on_progress, stop=stop, integrator=integrator, interrupted=flag,
+                                    on_chunk=store.on_chunk)
             store.compile_time = outcome.compile_time
             if outcome.status == INTERRUPTED and writer.pending:
                 return _not_replaced(model, writer, store, outcome)
@@ -488,9 +489,9 @@ def _run_in_folder(model: Model, grid: TimeGrid, writer, integrator: Integrator 
                 files = {TRAJECTORY: {k: a for k, a in arrays.items() if k != "ledger"},
                          LEDGER: ledger_arrays(arrays["t"], arrays["ledger"], outcome.energy0)}
                 writer.finish(outcome.status, outcome.integrator.state(), files, summary, outcome.message)
-    finally:
-        store.close()
-        writer.close()
+        finally:
+            store.close()
+            writer.close()
     return Trajectory.open(writer.folder, verify=False)
 
 
