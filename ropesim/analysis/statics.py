@@ -45,18 +45,19 @@ def equilibrium(scene: S.Scene) -> StaticShape:
     model = build(scene, solve=False)
     result = solve_equilibrium(model)
     x = np.ascontiguousarray(result.x)
-    supports, tension = _loads(model, x)
+    supports, tension = static_loads(model, x)
     grounded, length, touchdown = _on_the_seabed(model, x)
     return StaticShape(model, x.T.copy(), result.residual, result.scale, result.iterations, result.converged,
                        model.held_idx.copy(), supports, tension, grounded, length, touchdown)
 
 
-def _loads(model: Model, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def static_loads(model: Model, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The support forces (H, D) [N] and segment tensions [N] of the nodes at rest at ``x`` (D, N)."""
     from ..model.forces.springs import segment_forces
     from ..model.terms import accelerations
 
     v, acc = np.zeros_like(x), np.zeros_like(x)
-    accelerations(x, v, acc, model.params, _steady_time(model.scene))
+    model.kernel(accelerations)(x, v, acc, model.params, _steady_time(model.scene))
     idx = model.held_idx
     supports = -(model.mass[idx][:, None] * acc[:, idx].T)
     tension = segment_forces(model, x.T[None], v.T[None])[0]

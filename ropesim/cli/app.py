@@ -327,6 +327,10 @@ def check(scene_file: SceneArg, sets: SetOpt = None) -> None:
 
 @app.command(cls=Command, name="compile")
 def compile_(
+    scene_files: Annotated[Optional[list[str]], typer.Argument(
+        metavar="[SCENE]...", help="Compile for these scenes (built-in names or scene files; default: every "
+                                   "built-in scene).", show_default=False)] = None,
+    sets: SetOpt = None,
     methods: Annotated[Optional[list[str]], typer.Option(
         "--method", "-m", metavar="NAME", help="Compile only this integrator's kernels; repeatable or "
                                                "comma-separated (default: every integrator, and the static "
@@ -335,17 +339,20 @@ def compile_(
 ) -> None:
     """Compile every kernel into Numba's cache now, so that later runs start at once: for container images and CI.
 
-    A run compiles its integrator's time loop the first time (8 to 30 s, once; then it loads from the cache
-    in a fraction of a second). This compiles the loop of every integrator for every built-in scene, the
-    tension and support forces of a saved frame, and the static solver of initial.shape = "equilibrium", then
-    prints what it compiled and how long each took. The cache is the folder ropesim chose for this
-    installation (or NUMBA_CACHE_DIR): run it as the user who will run ropesim, on the same kind of CPU.
+    A scene compiles only the parts it uses, the first time it runs (a few seconds, once; then it loads from
+    the cache in a fraction of a second). This compiles the loop of every integrator for every built-in scene
+    (or the scenes given), the tension and support forces of a saved frame, and the static solver of
+    `ropesim equilibrium`, then prints what it compiled and how long each took. A scene of your own with parts
+    no built-in scene combines compiles its own copy: name it here to prepare it too. The cache is the folder
+    ropesim chose for this installation (or NUMBA_CACHE_DIR): run it as the user who will run ropesim, on the
+    same kind of CPU.
     """
     from .report import print_compiled
     from .status import Startup, cache_dir
     from ..kernels import STATIC_SOLVER, compile_all
 
     names = _methods(",".join(methods), "--method") if methods else None
+    scenes = [_load(name, sets)[0] for name in scene_files] if scene_files else None
     with Startup(not quiet and sys.stderr.isatty(), "ropesim compile") as status:
         status.watch()
 
@@ -353,9 +360,9 @@ def compile_(
             what = "the static solver" if name == STATIC_SOLVER else f"the {name} kernel"
             status.update(f"Loading {what} ({i + 1} of {n})", kernel=what)
 
-        results = compile_all(names, static_solver=names is None, on_start=starting)
+        results = compile_all(names, scenes, static_solver=names is None, on_start=starting)
     if not quiet:
-        print_compiled(results, cache_dir())
+        print_compiled(results, cache_dir(), builtin=scenes is None)
 
 
 @app.command(cls=Command)

@@ -48,8 +48,9 @@ def print_figures(console: Console, title: str, columns: list[str], rows: list[l
         console.print(table)
 
 
-def print_compiled(results, cache: str) -> None:
-    """What ``ropesim compile`` did, per integrator (and the static solver): time and functions compiled."""
+def print_compiled(results, cache: str, builtin: bool = True) -> None:
+    """What ``ropesim compile`` did, per integrator (and the static solver): time and functions compiled, for the
+    built-in scenes (``builtin``) or the scenes given."""
     rows = []
     for r in results:
         if r.functions:
@@ -63,8 +64,10 @@ def print_compiled(results, cache: str) -> None:
     print_figures(console, f"kernels in {cache}", ["kernel", "family", "time [s]", "what happened"], rows, keys=1,
                   left=(0, 1, 3))
     scenes = max((r.scenes for r in results if r.family != "statics"), default=0)
-    console.print(f"each integrator made ready for {scenes} built-in scene{'s' if scenes != 1 else ''} (its loop "
-                  f"serves every scene): runs load it from the cache instead of compiling")
+    which = "built-in scene" if builtin else "scene"
+    console.print(f"each integrator made ready for {scenes} {which}{'s' if scenes != 1 else ''}: their runs load it "
+                  f"from the cache instead of compiling (a scene with other parts compiles its own on its first "
+                  f"run; name it to `ropesim compile` to prepare it now)")
 
 
 def print_summary(summary: dict, folder: Path) -> None:

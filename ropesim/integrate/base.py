@@ -19,11 +19,15 @@ coefficients, a Runge-Kutta method's Butcher table), its order and a line of doc
    ``exact_contact_kicks`` (the thrower's and guides' damping is integrated exactly) and
    ``unconditionally_stable``.
 2. An :class:`Integrator` subclass whose ``__init__(model, grid, method)`` calls ``super().__init__`` (which
-   sets x, v, the ledger, the health limits, the held nodes and the step counter) and builds the family's
-   own state and scratch arrays from the :class:`~ropesim.model.build.Model`, and which provides:
+   sets x, v, the ledger, the health limits, the held nodes, the step counter and the compile-time switches)
+   and builds the family's own state and scratch arrays from the :class:`~ropesim.model.build.Model`, and
+   which provides:
 
    - :meth:`Integrator._run` ``(n, frames)``: call the family's compiled loop for ``n`` steps from
-     ``self.step``, returning ``(steps done, frames written, status, node)``;
+     ``self.step``, returning ``(steps done, frames written, status, node)``. The loop is the copy
+     ``self.kernel(loop)`` specialised on the run's switches (:func:`ropesim.model.jit.specialise`): the
+     model's (its terms, prescribed motion) and any the family adds to ``self.switches`` in ``__init__``
+     before taking the copy (the splitting family's plain stage);
    - :attr:`Integrator.force_evaluations`: force evaluations so far (Newton iterations for an implicit
      method);
    - ``STATE``: the names of its attributes (arrays, updated in place) that, with x, v, the ledger and the
@@ -63,6 +67,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..model.jit import specialise
 from ..model.motion import place_moving
 from .health import LEDGER_COLUMNS, OK, initial_ledger, limits
 
@@ -180,6 +185,11 @@ class Integrator:
             place_moving(self.x, self.v, self.held, 0.0)   # a sinusoid starts with its own velocity
         self.ledger = initial_ledger(model, self.x, self.v)
         self.limits = limits(model)
+        self.switches = model.switches
+
+    def kernel(self, function):
+        """``function`` (a compiled template) specialised on this run's switches."""
+        return specialise(function, self.switches)
 
     # -- what a family provides --------------------------------------------------------------------------
 

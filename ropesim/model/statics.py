@@ -55,7 +55,7 @@ class Equilibrium:
 
 
 @jit.kernel
-def _forces(x, v, acc, p, t, mass, free, out):
+def forces_on_free_nodes(x, v, acc, p, t, mass, free, out):
     """The net static force [N] on every free node (0 on held nodes) into ``out`` (flat, node-major); returns
     its largest component."""
     accelerations(x, v, acc, p, t)
@@ -76,6 +76,8 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     x = np.array(model.x0 if x is None else x, dtype=float)
     dim, n = x.shape
     scene, p = model.scene, model.params
+    static_force, nonconservative, energy_of, jacobian = (model.kernel(f) for f in (
+        forces_on_free_nodes, nonconservative_forces, mechanical_energy, newton_matrix))
     free = np.ascontiguousarray(~model.held)
     mass = model.mass
     v = np.zeros_like(x)
@@ -88,15 +90,15 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     nodes = (free, mass, np.where(model.held, 0.0, model.drag))
     force, trial, other = np.zeros(nt), np.zeros(nt), np.zeros(nt)
     scale = _force_scale(model)
-    worst = _forces(x, v, acc, p, t, mass, free, force)
+    worst = static_force(x, v, acc, p, t, mass, free, force)
     norm = float(np.linalg.norm(force))
-    energy = _energy(x, v, mass, p)
+    energy = float(energy_of(x, v, mass, p)[0])
     tau = math.sqrt(float(mass[free].min()) / max(scene.rope.stiffness, 1e-300))   # one spring's period
     reach = scene.rope.segment_length
     for iteration in range(1, max_iterations + 1):
         if worst <= tol * scale:
             return Equilibrium(x, worst, scale, iteration - 1, True)
-        newton_matrix(x, v, jac, tau, nodes, p, t)   # M + tau b + tau^2 K + tau C, so the step is tau^2 F
+        jacobian(x, v, jac, tau, nodes, p, t)   # M + tau b + tau^2 K + tau C, so the step is tau^2 F
         if not factor(jac.band, jac.corner, cyclic, jac.band.shape[0] - 1, wood):
             tau *= 0.25
             continue
@@ -111,13 +113,13 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
             if tau < 1e-30:
                 break
             continue
-        _nonconservative(x, v, acc, p, t, mass, free, other)
+        nonconservative(x, v, acc, p, t, mass, free, other)
         drift = float(step @ other)
         fraction, accepted = 1.0, False
         while fraction > 1e-6:
             candidate = x + fraction * step.reshape(n, dim).T
-            trial_energy = _energy(candidate, v, mass, p)
-            better = _forces(candidate, v, acc, p, t, mass, free, trial)
+            trial_energy = float(energy_of(candidate, v, mass, p)[0])
+            better = static_force(candidate, v, acc, p, t, mass, free, trial)
             new_norm = float(np.linalg.norm(trial))
             change = trial_energy - energy - fraction * drift
             if change <= 1e-4 * fraction * slope or (
@@ -136,12 +138,8 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     return Equilibrium(x, worst, scale, max_iterations, worst <= tol * scale)
 
 
-def _energy(x, v, mass, p) -> float:
-    return float(mechanical_energy(x, v, mass, p)[0])
-
-
 @jit.kernel
-def _nonconservative(x, v, acc, p, t, mass, free, out):
+def nonconservative_forces(x, v, acc, p, t, mass, free, out):
     """The force [N] of the terms that are not conservative (drag in the flow; the others vanish at rest) on
     every free node into ``out`` (flat, node-major)."""
     dim, n = x.shape

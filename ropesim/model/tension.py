@@ -48,9 +48,10 @@ def support_forces(model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> np.nda
     mass = model.mass[idx][:, None]
     acc = np.zeros((model.dim, model.nodes))
     out = np.zeros((len(t), idx.size, model.dim))
+    forces = model.kernel(accelerations)
     for k in range(len(t)):
         xk, vk = np.ascontiguousarray(np.asarray(x[k]).T), np.ascontiguousarray(np.asarray(v[k]).T)
-        accelerations(xk, vk, acc, model.params, float(t[k]))
+        forces(xk, vk, acc, model.params, float(t[k]))
         force = mass * acc[:, idx].T - (model.drag[idx][:, None] * vk[:, idx].T)
         out[k] = -force
         if m.moving:
