@@ -15,6 +15,7 @@ from typer.testing import CliRunner
 import ropesim
 from ropesim.cli.app import app
 from ropesim.io.export import ExportError, export
+from ropesim.install import install_hint
 
 from conftest import SCENARIOS
 
@@ -112,9 +113,10 @@ def test_a_missing_extra_names_it(runs, monkeypatch):
     monkeypatch.setitem(sys.modules, "meshio", None)   # as if not installed: importing it raises ImportError
     result = invoke("export", runs["shooter_low"], "--to", "vtk", "-o", runs["shooter_low"] / "v2")
     assert result.exit_code == 2
-    assert result.stderr == "ropesim: --to vtk: needs meshio, which is not installed; pip install 'ropesim[export]'\n"
+    assert result.stderr == ("ropesim: --to vtk: needs meshio, which is not installed; "
+                             f"{install_hint('export')}\n")   # pip install -e '<checkout>[export]' here
     assert not (runs["shooter_low"] / "v2").exists()
-    with pytest.raises(ExportError, match="ropesim\\[export\\]"):
+    with pytest.raises(ExportError, match="\\[export\\]"):
         export(ropesim.Trajectory.open(runs["shooter_low"]), "vtk")
 
 

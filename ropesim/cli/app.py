@@ -688,8 +688,8 @@ def export(
     """Export a run for the tools engineers use: a VTK series for ParaView, or CSV for spreadsheets.
 
     vtk: one .vtu per saved frame (the nodes joined by line cells, with velocity and speed per node) and a .pvd
-    that lists them with their times: open the .pvd in ParaView and press play. Written with meshio (pip
-    install 'ropesim[export]'): 2 MB of pure Python that writes VTK's compressed XML correctly; pyvista would
+    that lists them with their times: open the .pvd in ParaView and press play. Written with meshio (the export
+    extra: pip install 'pyropesim[export]', or pip install -e '.[export]' in a checkout): 2 MB of pure Python that writes VTK's compressed XML correctly; pyvista would
     bring all of VTK.
 
     csv: long format, one row per node per frame, a header naming each column with its unit (t [s], node,

@@ -68,8 +68,9 @@ def require(fmt: str):
     try:
         return __import__(module)
     except ImportError:
-        raise ExportError(f"--to {fmt}: needs {module}, which is not installed; "
-                          f"pip install 'ropesim[{extra}]'") from None
+        from ..install import install_hint
+
+        raise ExportError(f"--to {fmt}: needs {module}, which is not installed; {install_hint(extra)}") from None
 
 
 def export(traj, fmt: str, out: str | Path | None = None) -> Exported:
