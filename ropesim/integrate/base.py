@@ -177,7 +177,7 @@ class Integrator:
         motion = model.motion._replace(accel=model.motion.accel.copy())
         self.held = Held(model.held_idx, model.held_x0, model.held_v.copy(), motion)
         if motion.moving:
-            place_moving(self.x, self.v, self.held, 0.0)   # a sinusoid starts with its own velocity
+            place_moving(self.x, self.v, self.held, 0.0, 0.0)   # a sinusoid starts with its own velocity
         self.ledger = initial_ledger(model, self.x, self.v)
         self.limits = limits(model)
 

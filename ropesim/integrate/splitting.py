@@ -250,8 +250,9 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
     for s in range(n_steps):
         step = step0 + s
         t = step * h
+        middle = t + 0.5 * h   # a path: every stage of this step on its piece (see ropesim/model/motion.py)
         if moving:   # the held nodes' velocities and accelerations at t, for the supports' power
-            place_moving(x, v, held, t)
+            place_moving(x, v, held, t, middle)
         if drift[0] != 0.0:
             ch = drift[0] * h
             for d in range(dim):
@@ -259,7 +260,7 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
                     x[d, i] += ch * v[d, i]
             t += ch
             if moving:
-                place_moving(x, v, held, t)
+                place_moving(x, v, held, t, middle)
             for j in range(n_held if not moving else 0):   # health.place_held, written out: its call cost 2.5 %
                 i = held_idx[j]
                 for d in range(dim):
@@ -403,7 +404,7 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
             if ch != 0.0:
                 t += ch
                 if moving:
-                    place_moving(x, v, held, t)
+                    place_moving(x, v, held, t, middle)
                 for j in range(n_held if not moving else 0):
                     i = held_idx[j]
                     for d in range(dim):

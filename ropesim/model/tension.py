@@ -56,7 +56,7 @@ def support_forces(model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> np.nda
         if m.moving:
             for j in range(idx.size):
                 for d in range(model.dim):
-                    out[k, j, d] += mass[j, 0] * offset(m, j, d, float(t[k]))[2]
+                    out[k, j, d] += mass[j, 0] * offset(m, j, d, float(t[k]), float(t[k]))[2]
     return out
 
 
