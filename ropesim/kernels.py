@@ -23,6 +23,25 @@ from dataclasses import dataclass, replace
 from typing import Callable
 
 STATIC_SOLVER = "static solver"
+FIRST_COMPILE_SECONDS = (8, 30)   # a family's loop and terms, compiled once (scripts/bench_compile.py)
+
+
+def loop_cached(method: str) -> bool | None:
+    """Whether ``method``'s time loop is in Numba's cache for the running source (a run then compiles nothing),
+    read from the cache's index without compiling; None when Numba's cache cannot be read that way."""
+    from .integrate.methods import get_method
+
+    kind = get_method(method).kind
+    if kind == "rk":
+        from .integrate.rk import advance_rk as loop
+    elif kind == "implicit":
+        from .integrate.sdirk import advance_sdirk as loop
+    else:
+        from .integrate.splitting import advance_splitting as loop
+    try:
+        return bool(loop._cache._cache_file._load_index())   # {} unless an entry matches the source's stamp
+    except Exception:   # Numba's private cache API moved: say nothing rather than guess
+        return None
 
 
 @dataclass

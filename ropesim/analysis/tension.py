@@ -28,5 +28,5 @@ def tension_figures(t: np.ndarray, tension: np.ndarray, block: int) -> dict:
         "start_N": float(last[0]), "end_N": float(last[-1]),
         "start_min_N": start_range[0], "start_max_N": start_range[1],
         "end_min_N": end_range[0], "end_max_N": end_range[1],
-        "max_N": best, "max_segment": where, "max_t_s": float(t[when]),
+        "max_N": best, "max_segment": where, "max_t_s": float(f"{float(t[when]):.12g}"),
     }

@@ -277,6 +277,8 @@ def _check_size(scene, where: str, folder: Path, force: bool, quiet: bool) -> No
 
 
 def _duration(seconds: float) -> str:
+    if seconds < 1:
+        return "under a second"
     if seconds < 120:
         return f"{seconds:.0f} s"
     if seconds < 7200:
@@ -316,13 +318,27 @@ def check(scene_file: SceneArg, sets: SetOpt = None) -> None:
     est, folder = estimate(scene), Path("runs") / scene.name
     free = free_bytes(folder)
     typer.echo(f"output: about {human(est.bytes)} in {est.frames:,} frames ({human(est.peak_bytes)} while the "
-               f"run finishes; {human(free)} free at {folder}); run time about {_duration(est.seconds)}")
+               f"run finishes; {human(free)} free at {folder}); run time {'about ' * (est.seconds >= 1)}"
+               f"{_duration(est.seconds)}"
+               f"{_compile_note(scene.integrator.method)}")
     if est.peak_bytes > free:
         typer.echo(f"ropesim: warning: {where}: the disk at {folder} cannot hold the frames; `ropesim run` "
                    f"refuses it without --force", err=True)
     elif est.bytes > WARN_BYTES or est.seconds > WARN_SECONDS:
         typer.echo(f"ropesim: warning: {where}: a large run (about {human(est.bytes)}, {_duration(est.seconds)})",
                    err=True)
+
+
+def _compile_note(method: str) -> str:
+    """What a first run adds to the run time: compiling the method's loop, unless Numba's cache has it."""
+    from ..kernels import FIRST_COMPILE_SECONDS, loop_cached
+
+    cached = loop_cached(method)
+    if cached:
+        return f" ({method}'s kernel is in the cache: no compiling)"
+    low, high = FIRST_COMPILE_SECONDS
+    return (f", after compiling {method}'s kernel{' once' if cached is False else ', if not in the cache'} "
+            f"({low} to {high} s; `ropesim compile` does it ahead)")
 
 
 @app.command(cls=Command, name="compile")

@@ -87,8 +87,9 @@ def print_summary(summary: dict, folder: Path) -> None:
     energy = summary.get("final_energy_J")
     if energy:
         rows.append(("final energy", ", ".join(f"{k} {v:.6g} J" for k, v in energy.items())))
-        rows.append(("largest stretch", f"{100 * summary['max_spring_stretch']:.3g} % "
-                                        f"(at t = {summary['max_spring_stretch_t']:.3g} s)"))
+        rows.append(("largest stretch", f"{100 * summary['max_spring_stretch']:.3g} % of the rest length "
+                                        f"(max_spring_stretch {summary['max_spring_stretch']:.3g}; over the saved "
+                                        f"frames, at t = {summary['max_spring_stretch_t']:.3g} s)"))
     towed = summary.get("towed")
     if towed:
         rows.append(("rope angle", f"top {towed['top_angle_deg']:.2f} deg, bottom {towed['bottom_angle_deg']:.2f} "
@@ -231,13 +232,15 @@ def _seabed_text(bed) -> str:
 def _motion_text(drive) -> str:
     """How a driven node moves: its constant velocity, and its sinusoid and path, ramped in."""
     parts = [f"at {list(drive.velocity)} m/s"] if any(drive.velocity) or not drive.moving else []
-    if drive.amplitude is not None:
-        axes = [f"{'xyz'[k]} {a:g} m, {drive.period[k]:g} s" + (f", {drive.phase[k]:g} deg" if drive.phase[k] else "")
-                for k, a in enumerate(drive.amplitude) if a]
+    axes = [f"{'xyz'[k]} {a:g} m, {drive.period[k]:g} s" + (f", {drive.phase[k]:g} deg" if drive.phase[k] else "")
+            for k, a in enumerate(drive.amplitude or ()) if a]
+    if axes:
         parts.append("sinusoid " + "; ".join(axes))
     if drive.path_table is not None:
         parts.append(f"a path of {len(drive.path_table)} rows")
-    ramp = f", ramped in over {drive.ramp_time:g} s" if drive.moving and drive.ramp_time else ""
+    if not parts:
+        return "held still (every amplitude is 0)"
+    ramp = f", ramped in over {drive.ramp_time:g} s" if (axes or drive.path_table is not None) and drive.ramp_time else ""
     return " + ".join(parts) + ramp
 
 
