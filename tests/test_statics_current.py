@@ -42,8 +42,10 @@ def hanging_line(current: float, cd_normal: float = 1.2, cd_tangential: float = 
     return ropesim.scene_from_toml(tomli_w.dumps(scene))
 
 
-CASES = ([(u, 1.2, 0.01) for u in (0.0, 0.25, 0.5, 1.0, 1.5, 2.0, 3.0)]
-         + [(u, 2.0, 0.5) for u in (0.5, 1.0, 3.0)] + [(1.0, 0.6, 0.0)])
+FAST = {(1.0, 1.2, 0.01), (3.0, 2.0, 0.5)}   # the scene, and the strongest current; the rest in -m slow
+CASES = [pytest.param(*case, marks=() if case in FAST else pytest.mark.slow)
+         for case in ([(u, 1.2, 0.01) for u in (0.0, 0.25, 0.5, 1.0, 1.5, 2.0, 3.0)]
+                      + [(u, 2.0, 0.5) for u in (0.5, 1.0, 3.0)] + [(1.0, 0.6, 0.0)])]
 
 
 @pytest.mark.parametrize("current,cd_normal,cd_tangential", CASES)
