@@ -1,7 +1,7 @@
 """How to install ropesim and its extras, as ropesim itself tells a user (one place for every install hint).
 
 The distribution is called ``pyropesim`` on the package index (the name ``ropesim`` there belongs to an
-unrelated project: ``pip install ropesim`` would install someone else's code); the import name and the command
+unrelated project, whose code installing by that name would bring); the import name and the command
 stay ``ropesim``. A hint names what installs the missing part into the installation that is running: from
 its checkout when ropesim was installed editable from one (``pip install -e '/path/to/checkout[export]'``),
 else by the distribution's name (``pip install 'pyropesim[export]'``).
