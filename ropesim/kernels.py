@@ -24,6 +24,22 @@ from dataclasses import dataclass, replace
 from typing import Callable
 
 STATIC_SOLVER = "static solver"
+FIRST_COMPILE_SECONDS = (8, 30)   # a family's loop and terms, compiled once (scripts/bench_compile.py)
+
+
+def loop_cached(scene) -> bool | None:
+    """Whether the time loop a run of ``scene`` calls (its method's, for its parts) is in Numba's cache for the
+    running source (a run then compiles nothing), read from the cache's index without compiling; None when
+    Numba's cache cannot be read that way."""
+    from .integrate.methods import get_method
+    from .model.build import build
+
+    method = get_method(scene.integrator.method)
+    loop = method.family.compiled_loop(build(scene, solve=False), method)
+    try:
+        return bool(loop._cache._cache_file._load_index())   # {} unless an entry matches the source's stamp
+    except Exception:   # Numba's private cache API moved: say nothing rather than guess
+        return None
 
 
 @dataclass

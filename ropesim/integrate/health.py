@@ -151,11 +151,11 @@ def held_power(acc, mass, held):
 
 
 @jit.kernel
-def place(x, v, held, t):
+def place(x, v, held, t, t_piece):
     """Put every held node where it must be at time t: x0 + V t, or its prescribed motion (which also sets its
-    velocity in ``v``, see :mod:`ropesim.model.motion`)."""
+    velocity in ``v``; a path on its piece that holds ``t_piece``, see :mod:`ropesim.model.motion`)."""
     if WITH_MOTION:
-        place_moving(x, v, held, t)
+        place_moving(x, v, held, t, t_piece)
     else:
         place_held(x, held.idx, held.x0, held.v, t)
 

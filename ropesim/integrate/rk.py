@@ -87,7 +87,10 @@ class RungeKuttaFamily(Integrator):
         self.scratch = RKScratch(np.zeros(shape), np.zeros(shape), np.zeros((stages,) + shape),
                                  np.zeros((stages,) + shape), np.zeros(shape), np.zeros(shape))
         self.gamma = np.where(model.held, 0.0, model.drag / model.mass)
-        self.loop = self.kernel(advance_rk)
+
+    @staticmethod
+    def template():
+        return advance_rk
 
     @property
     def force_evaluations(self) -> int:
@@ -151,7 +154,7 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
         t = step * h
         for st in range(stages):
             stage_state(x, v, kx, kv, a, st, h, xs, vs)
-            place(xs, vs, held, t + c[st] * h)
+            place(xs, vs, held, t + c[st] * h, t + 0.5 * h)   # a path: this step's piece
             for j in range(held_idx.shape[0]):
                 for d in range(dim):
                     vs[d, held_idx[j]] = held_v[d, j]
@@ -177,7 +180,7 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
                 applied_accelerations(xs, vs, acc_box, params)
                 ledger[BOX] += wh * power(acc_box, vs, mass)
         combine(x, v, kx, kv, b, h)
-        place(x, v, held, (step + 1) * h)
+        place(x, v, held, (step + 1) * h, (step + 1) * h)
         done = step + 1
         if not due(done, schedule):
             continue  # nothing due: skip the call, whose array arguments cost more than a small rope's step

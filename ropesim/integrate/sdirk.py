@@ -115,7 +115,10 @@ class SdirkFamily(Integrator):
         self.stage = Stage(*(np.zeros(shape) for _ in Stage._fields))
         self.nodes = Nodes(np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag))
         self.stats = np.zeros(1, dtype=np.int64)
-        self.loop = self.kernel(advance_sdirk)
+
+    @staticmethod
+    def template():
+        return advance_sdirk
 
     @property
     def force_evaluations(self) -> int:
@@ -194,7 +197,7 @@ def take_back_half(X, step):
 
 
 @jit.kernel
-def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
+def solve_stage(stage, newton, beta, t_stage, t_piece, held, nodes, params):
     """Newton solve of one stage: X = xh + beta V, V = vh + beta (a(X, V) - gamma V). Returns
     (iterations, node, fluid power [W], internal-damping power [W]): iterations < 0 when it failed, naming the
     node that moved most in the last one. With added mass the stage's equation is M (V - vh) = beta (F - b V),
@@ -207,7 +210,7 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     for d in range(dim):
         for i in range(n):
             X[d, i] = xh[d, i] + beta * vh[d, i]
-    place(X, V, held, t_stage)
+    place(X, V, held, t_stage, t_piece)   # a path: the step's piece (t_piece its middle)
     worst_node = -1
     last = np.inf            # the residual's norm before the last update
     stride = 0.0             # the last update's largest component [m]
@@ -260,7 +263,8 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
                 vh[d, i] = v[d, i]
         for k in range(2):
             t_stage = t + (GAMMA if k == 0 else 1.0) * h
-            its, node, fluid, internal, seabed = solve_stage(stage, newton, beta, t_stage, held, nodes, params)
+            its, node, fluid, internal, seabed = solve_stage(stage, newton, beta, t_stage, t + 0.5 * h, held, nodes,
+                                                             params)
             if its < 0:
                 return s, frame, NEWTON_FAILED, node
             stats[0] += its
@@ -292,7 +296,7 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
             for i in range(n):
                 x[d, i] = X[d, i]
                 v[d, i] = V[d, i]
-        place(x, v, held, (step + 1) * h)
+        place(x, v, held, (step + 1) * h, (step + 1) * h)
         done = step + 1
         if not due(done, schedule):
             continue  # nothing due: skip the call, whose array arguments cost more than a small rope's step

@@ -182,9 +182,10 @@ class Splitting(Integrator):
         self.reuse_force = method.reuses_last_force and not model.velocity_dependent
         decay, gain, travel = kick_factors(method, grid.dt, model.drag, model.mass, model.held)
         self.kicks = Kicks(np.array(method.drift), np.array(method.kick), decay, gain, travel, self.reuse_force)
-        plain = specialise and applies(model, method)
-        if plain:
-            self.switches = self.switches | {WITH_PLAIN_STAGE.name}
+        if not specialise:
+            self.switches = self.switches - {WITH_PLAIN_STAGE.name}
+            self.loop = self.kernel(advance_splitting)
+        plain = self.on_plain_stage
         self.plain = plain_bundle(model, decay, gain, travel) if plain else inactive_bundle(stages)
         self.acc = np.zeros_like(self.x)
         self.have_acc = np.zeros(1, dtype=np.bool_)
@@ -196,7 +197,15 @@ class Splitting(Integrator):
                                velocity_scratch(*self.x.shape))
         self.bundle = SplittingState(self.x, self.v, self.acc, self.have_acc, self.ledger, self.spring_forces,
                                      self.lost)
-        self.loop = self.kernel(advance_splitting)
+
+    @staticmethod
+    def template():
+        return advance_splitting
+
+    @classmethod
+    def switches_for(cls, model, method) -> frozenset:
+        """The model's switches, and the plain stage where it applies."""
+        return model.switches | ({WITH_PLAIN_STAGE.name} if applies(model, method) else set())
 
     @property
     def on_plain_stage(self) -> bool:
@@ -251,8 +260,9 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
     for s in range(n_steps):
         step = step0 + s
         t = step * h
+        middle = t + 0.5 * h   # a path: every stage of this step on its piece (see ropesim/model/motion.py)
         if WITH_MOTION:   # the held nodes' velocities and accelerations at t, for the supports' power
-            place_moving(x, v, held, t)
+            place_moving(x, v, held, t, middle)
         if drift[0] != 0.0:
             ch = drift[0] * h
             for d in range(dim):
@@ -260,7 +270,7 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
                     x[d, i] += ch * v[d, i]
             t += ch
             if WITH_MOTION:
-                place_moving(x, v, held, t)
+                place_moving(x, v, held, t, middle)
             for j in range(n_held if not WITH_MOTION else 0):   # health.place_held, written out: its call cost 2.5 %
                 i = held_idx[j]
                 for d in range(dim):
@@ -404,7 +414,7 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
             if ch != 0.0:
                 t += ch
                 if WITH_MOTION:
-                    place_moving(x, v, held, t)
+                    place_moving(x, v, held, t, middle)
                 for j in range(n_held if not WITH_MOTION else 0):
                     i = held_idx[j]
                     for d in range(dim):

@@ -206,6 +206,71 @@ def add_fluid_jacobian(x, v, band, beta, free, p, t):
                 band[a - b, i * dim + b] += beta * c
 
 
+@jit.kernel
+def add_fluid_tangent_stiffness(x, v, blocks, free, p, t):
+    """Add the drag's stiffness through the node tangent, K = -dF_i/dx_j, to ``blocks`` (N, 3, D, D): node i's
+    block for its neighbour before it (round a loop), itself and the one after. :func:`add_fluid_jacobian`
+    freezes the tangent q; for the static solver this is the missing part of Newton's matrix, and for a line
+    hanging in a current it is as large as the springs' own sideways stiffness (:mod:`ropesim.model.statics`).
+
+    With u = v - U, a = u . q, u_n = u - a q and W = q u^T + a I (= d(a q)/dq):
+    dF/dq = c_n L (|u_n| W + a u_n u_n^T / |u_n|) - c_t L (2 |a| q u^T + |a| a I) + L (b_n - b_t) W, and
+    q = (x_hi - x_lo) / r gives dF/dx_hi = -dF/dx_lo = dF/dq (I - q q^T) / r. Not symmetric: the static
+    solver applies it beside the banded matrix rather than in it. Held rows are skipped; the caller leaves out
+    held columns.
+    """
+    dim, n = x.shape
+    closed = p.spring[2] != 0.0
+    flow, table = p.flow
+    c_n, c_t = p.fluid_drag[0], p.fluid_drag[1]
+    b_n, b_t = p.viscous_drag[0], p.viscous_drag[1]
+    for i in range(n):
+        if not free[i]:
+            continue
+        lo, hi = i - 1, i + 1
+        if lo < 0:
+            lo = n - 1 if closed else 0
+        if hi >= n:
+            hi = 0 if closed else n - 1
+        e0, e1 = x[0, hi] - x[0, lo], x[1, hi] - x[1, lo]
+        e2 = x[2, hi] - x[2, lo] if dim == 3 else 0.0
+        r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        if r == 0.0:
+            continue
+        q = (e0 / r, e1 / r, e2 / r)
+        ux = uy = uz = 0.0
+        if WITH_FLOW:
+            ux, uy, uz = flow_at(x[1, i], t, flow, table)
+        u = (v[0, i] - ux, v[1, i] - uy, v[2, i] - uz if dim == 3 else 0.0)
+        a = u[0] * q[0] + u[1] * q[1] + u[2] * q[2]
+        un = (u[0] - a * q[0], u[1] - a * q[1], u[2] - a * q[2])
+        sn = math.sqrt(un[0] * un[0] + un[1] * un[1] + un[2] * un[2])
+        cn = c_n * p.node_length[i] if WITH_FLUID_DRAG else 0.0
+        ct = c_t * p.node_length[i] if WITH_FLUID_DRAG else 0.0
+        lin = p.node_length[i] * (b_n - b_t) if WITH_VISCOUS_DRAG else 0.0
+        before = 0 if lo != i else 1
+        after = 2 if hi != i else 1
+        for j in range(dim):
+            mq = 0.0
+            for k in range(3):
+                mq += _drag_by_tangent(j, k, q, u, a, un, sn, cn, ct, lin) * q[k]
+            for k in range(dim):
+                stiffness = (_drag_by_tangent(j, k, q, u, a, un, sn, cn, ct, lin) - mq * q[k]) / r   # dF_j/dx_hi,k
+                blocks[i, after, j, k] -= stiffness
+                blocks[i, before, j, k] += stiffness
+
+
+@jit.kernel(inline="always")
+def _drag_by_tangent(j, k, q, u, a, un, sn, cn, ct, lin):
+    """dF_j/dq_k of a node's drag (see :func:`add_fluid_tangent_stiffness`); cn = c_n L, ct = c_t L, lin =
+    L (b_n - b_t)."""
+    w = q[j] * u[k] + (a if j == k else 0.0)
+    m = cn * sn * w + lin * w
+    if sn > 0.0:
+        m += cn * a * un[j] * un[k] / sn
+    return m - ct * (2.0 * abs(a) * q[j] * u[k] + (abs(a) * a if j == k else 0.0))
+
+
 def speed_scale(model) -> float:
     """A speed [m/s] the run's relative velocities stay near: twice the largest of the initial and held node
     speeds, the flow's largest speed and the thrower's v_max (for the stability bound of velocity-dependent
