@@ -1,19 +1,20 @@
 """Numba's compiled kernels: what a run compiles, and compiling all of them ahead of time (``ropesim compile``).
 
-Every compiled function of ropesim is ``cache=True``. The first run of an integrator compiles its loop and the
-force terms it calls (8 to 30 seconds; ``scripts/bench_compile.py`` measures each method) and Numba writes them
-to its cache (:mod:`ropesim.io.numba_cache` says where); later runs load them in a fraction of a second.
+Every compiled function of ropesim is ``cache=True``. The first run of a scene with an integrator compiles
+that family's loop with the force terms the scene declares, and nothing else (a few seconds;
+``scripts/bench_first_run.py`` measures every built-in scene), and Numba writes it to its cache
+(:mod:`ropesim.io.numba_cache` says where); later runs load it in a fraction of a second.
 
-What compiles depends on the integrator's family (splitting, Runge-Kutta, SDIRK), not on the scene: every
-force term sits behind a flag and an undeclared term gets empty parameters of the same types
-(:mod:`ropesim.model.terms`), so one signature of each family's loop serves every scene, 2-D or 3-D, and the
-four splitting methods share one loop. Besides the loop a run compiles the helpers it calls from Python: the
-plain stage's set-up, the tension and support forces of each saved frame, and, for a scene that starts in its
-static equilibrium, the static solver.
+What compiles depends on the integrator's family (splitting, Runge-Kutta, SDIRK) and on the scene's
+compile-time switches: its declared terms, prescribed motion and, for the splitting family, the plain stage
+(:mod:`ropesim.model.jit`, :func:`ropesim.model.terms.switches`). Scenes with the same switches share every
+compiled function, 2-D or 3-D, and the four splitting methods share one loop. Besides the loop a run compiles
+the helpers it calls from Python: the plain stage's set-up, the support forces of each saved frame, and, for
+a scene that starts in its static equilibrium, the static solver.
 
 :func:`warm_up` compiles (or loads) everything a run of one scene compiles; :func:`compile_all` does it for
-every method on every built-in scene, and for the static solver. ``tests/test_compile.py`` checks that after
-it a run of any built-in scene, with any method, compiles nothing.
+every method on every built-in scene (or the scenes given), and for the static solver of each.
+``tests/test_compile.py`` checks that after it a run of those scenes, with any method, compiles nothing.
 """
 
 from __future__ import annotations
@@ -23,6 +24,22 @@ from dataclasses import dataclass, replace
 from typing import Callable
 
 STATIC_SOLVER = "static solver"
+FIRST_COMPILE_SECONDS = (8, 30)   # a family's loop and terms, compiled once (scripts/bench_compile.py)
+
+
+def loop_cached(scene) -> bool | None:
+    """Whether the time loop a run of ``scene`` calls (its method's, for its parts) is in Numba's cache for the
+    running source (a run then compiles nothing), read from the cache's index without compiling; None when
+    Numba's cache cannot be read that way."""
+    from .integrate.methods import get_method
+    from .model.build import build
+
+    method = get_method(scene.integrator.method)
+    loop = method.family.compiled_loop(build(scene, solve=False), method)
+    try:
+        return bool(loop._cache._cache_file._load_index())   # {} unless an entry matches the source's stamp
+    except Exception:   # Numba's private cache API moved: say nothing rather than guess
+        return None
 
 
 @dataclass
@@ -73,13 +90,18 @@ def warm_up(scene) -> None:
 
 
 def warm_up_static_solver(scene) -> None:
-    """Compile (or load) the static solver of ``initial.shape = 'equilibrium'``: one Newton iteration of it on
-    ``scene``'s model, from a guess off equilibrium."""
+    """Compile (or load) the static solver of ``initial.shape = 'equilibrium'`` and `ropesim equilibrium` for
+    ``scene``'s parts: one Newton iteration of it on ``scene``'s model, from a guess off equilibrium, and the
+    support forces it reports."""
+    import numpy as np
+
+    from .analysis.statics import static_loads
     from .model.build import build
     from .model.statics import solve_equilibrium
 
-    model = build(scene)
-    solve_equilibrium(model, model.x0 * 1.001 + 0.01, max_iterations=1)
+    model = build(scene, solve=False)
+    result = solve_equilibrium(model, model.x0 * 1.001 + 0.01, max_iterations=1)
+    static_loads(model, np.ascontiguousarray(result.x))
 
 
 class _Counter:
@@ -130,8 +152,9 @@ def compile_all(methods: list[str] | None = None, scenes: list | None = None, st
                 on_start(name, i, len(items))
             before, start = counter.functions, time.perf_counter()
             if name == STATIC_SOLVER:
-                warm_up_static_solver(scenes[0])
-                family, shared, count = "statics", "", 1
+                for scene in scenes:
+                    warm_up_static_solver(scene)
+                family, shared, count = "statics", "", len(scenes)
             else:
                 method = METHODS[name]
                 for scene in scenes:

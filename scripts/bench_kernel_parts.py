@@ -43,7 +43,6 @@ def contenders(n: int, steps: int) -> dict:
 
     out["yardstick"] = yard
     from ropesim.integrate.base import Schedule
-    from ropesim.integrate.splitting import advance_splitting
 
     for name, check_every, work in (("ropesim as run", 64, True), ("no blow-up check", NEVER, True),
                                     ("no check, no work term", NEVER, False)):
@@ -51,8 +50,8 @@ def contenders(n: int, steps: int) -> dict:
         plain, m = st.plain._replace(has_drag=work), st.model
 
         def run(st=st, plain=plain, m=m, check_every=check_every):
-            advance_splitting(st.bundle, st.kicks, plain, st.general, st.held, m.mass, m.params, st.limits,
-                              Schedule(st.step, steps, NEVER, h, NEVER, check_every), st.new_frames(0))
+            st.loop(st.bundle, st.kicks, plain, st.general, st.held, m.mass, m.params, st.limits,
+                    Schedule(st.step, steps, NEVER, h, NEVER, check_every), st.new_frames(0))
             st.step += steps
 
         run()   # compile this flag combination

@@ -10,8 +10,8 @@ rope does:
   bending stiffness EI, anisotropic linear drag, buoyancy and added mass of a near-weightless fluid's worth
   (which also brings in the flow's inertia force, its wind being ramped), and a body of negligible drag area.
 
-Each optional term sits behind its own flag, so an undeclared term costs one predictable branch per force
-evaluation; the ratio (padded / as declared) is what a scene would pay if the kernel evaluated every term.
+An undeclared term is not compiled at all (its compile-time switch is off, see ropesim/model/jit.py), so it
+costs nothing; the ratio (padded / as declared) is what a scene would pay if the kernel evaluated every term.
 The two variants alternate, repeat by repeat, so both see the same machine load, and the fastest call of each
 is kept (load only ever adds time).
 

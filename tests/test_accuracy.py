@@ -280,14 +280,14 @@ def test_exact_contact_kick_solves_the_linear_kick_equation():
 
     def rhs(vel):
         acc = np.zeros_like(x)
-        accelerations(x, vel, acc, model.params, 0.0)
+        model.kernel(accelerations)(x, vel, acc, model.params, 0.0)
         return acc - gamma * vel
 
     for tau in (0.01, -0.004):
         out, nodes = np.zeros_like(x), np.zeros(model.nodes, dtype=np.int64)
         acc = np.zeros_like(x)
-        accelerations(x, v, acc, model.params, 0.0)
-        count = exact_contact_kicks(x, v, acc, out, nodes, tau, gamma, free, model.params)
+        model.kernel(accelerations)(x, v, acc, model.params, 0.0)
+        count = model.kernel(exact_contact_kicks)(x, v, acc, out, nodes, tau, gamma, free, model.params)
         assert 10 in nodes[:count]
         w, steps = v.copy(), 2000
         h = tau / steps

@@ -322,7 +322,7 @@ def test_check_lists_the_parts_of_a_shooter():
     (["run", "--help"], ["SCENE", "built-in scene", "--out", "runs/<scene name>/", "--set", "KEY=VALUE",
                          "integrator.dt=0.002", "--quiet", "trajectory.npz"]),
     (["check", "--help"], ["SCENE", "--set", "KEY=VALUE", "stability bound"]),
-    (["export", "--help"], ["pip install 'ropesim[export]'", "(t [s], node, x [m]", "NetCDF is not offered"]),
+    (["export", "--help"], ["pip install 'pyropesim[export]'", "(t [s], node, x [m]", "NetCDF is not offered"]),
 ])
 def test_help(args, fragments):
     result = invoke(*args)

@@ -205,9 +205,9 @@ def test_morison_drag_is_the_formula_evaluated_directly(seed, dim, n, cd_n, cd_t
     x = rng.normal(scale=2.0, size=(dim, n))
     v = rng.normal(size=(dim, n))
     total = np.zeros((dim, n))
-    accelerations(x, v, total, model.params, 0.0)
+    model.kernel(accelerations)(x, v, total, model.params, 0.0)
     springs = np.zeros((dim, n))
-    accelerations(x, flow[:, None] + 0.0 * v, springs, model.params, 0.0)   # at zero relative velocity: no drag
+    model.kernel(accelerations)(x, flow[:, None] + 0.0 * v, springs, model.params, 0.0)   # at zero relative velocity: no drag
     got = (total - springs) * model.mass
     want = morison_node_forces(x.T, v.T, [l0] * (n - 1), d, rho, cd_n, cd_t, flow=flow).T
     np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9 * (1.0 + np.abs(want).max()))
@@ -228,7 +228,7 @@ def test_added_mass_solves_the_mass_matrix_equation(seed, dim):
     v = rng.normal(size=(dim, n))
     force = rng.normal(size=(dim, n))
     acc = force / model.mass
-    power = added_mass(x, v, acc, model.params)
+    power = model.kernel(added_mass)(x, v, acc, model.params)
     volume = math.pi * 0.05 ** 2 / 4 * np.where(np.arange(n) % (n - 1) == 0, 0.5, 1.0)
     for i in range(n):
         lo, hi = max(i - 1, 0), min(i + 1, n - 1)

@@ -281,14 +281,15 @@ def test_the_beams_release_over_six_seconds(stored):
 # ------------------------------------------------------------------------------------------------ what is left
 
 
-@pytest.mark.xfail(strict=True, reason="a step that ends on a row of a driven node's path_table takes the next "
-                                       "row's velocity at its last stage (the row's time decides the piece, "
-                                       "ropesim/model/motion.py offset), so every method is first order there; "
-                                       "MoorDyn moves a coupled point on one piece for the whole coupling step")
-def test_steps_ending_on_the_paths_rows_keep_rk4s_order():
+@pytest.mark.parametrize("method,order", [("symplectic_euler", 1), ("verlet", 2), ("yoshida4", 4), ("pefrl", 4),
+                                          ("rk4", 4), ("sdirk2", 2)])
+def test_steps_ending_on_the_paths_rows_keep_each_methods_order(method, order):
     """A 4-segment line, heavily damped axially, its end driven along a sinusoid sampled every 0.1 s (a
-    piecewise-linear path): rk4 with steps that divide 0.1 s should converge at fourth order, as it does within
-    each piece. It converges at first order: halving the step from 12.5 ms shrinks the error 1.7 times, not 16."""
+    piecewise-linear path): with steps that divide 0.1 s every method converges at its own order, as within
+    each piece, because every stage of a step moves the node on that step's piece (ropesim/model/motion.py).
+    Once a stage on a row took the next piece's velocity, and every method fell to first order (rk4: halving
+    the step from 12.5 ms shrank the error 1.7 times, not 16). MoorDyn moves a coupled point on one piece for
+    the whole coupling step too."""
     import tomli_w
 
     import ropesim
@@ -298,13 +299,13 @@ def test_steps_ending_on_the_paths_rows_keep_rk4s_order():
         scene = {"dimension": 2, "rope": {"length": 4.0, "segments": 4, "mass_per_length": 2.0, "EA": 4000.0,
                                           "axial_damping": 100.0, "compression": False},
                  "initial": {"shape": "line", "start": [0.0, 0.0], "end": [4.0, 0.0]},
-                 "integrator": {"method": "rk4", "dt": dt, "t_end": 4.0}, "output": {"interval": 0.1},
+                 "integrator": {"method": method, "dt": dt, "t_end": 4.0}, "output": {"interval": 0.1},
                  "gravity": {"g": 9.81}, "pinned": {"nodes": [0]}, "driven": [{"nodes": [-1], "path_table": rows}]}
         return np.asarray(ropesim.simulate(ropesim.scene_from_toml(tomli_w.dumps(scene))).x)
 
-    reference = run(0.1 / 256)
-    coarse, fine = (np.abs(run(0.1 / k) - reference).max() for k in (8, 16))
-    assert coarse / fine > 8.0, (coarse, fine)
+    reference = run(0.1 / 512)
+    coarse, fine = (np.abs(run(0.1 / k) - reference).max() for k in (16, 32))
+    assert coarse / fine > 2.0 ** (order - 0.5), (coarse, fine, coarse / fine)   # 1.4, 2.8, 11.3 for 1, 2, 4
 
 
 @pytest.mark.slow

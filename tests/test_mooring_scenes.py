@@ -88,7 +88,7 @@ def _support(model, x):
     """The force [N] the supports exert on the held nodes (H, D) in the static shape x: minus the net force of
     everything else on them."""
     acc = np.zeros_like(x)
-    accelerations(x, np.zeros_like(x), acc, model.params, 1.0)
+    model.kernel(accelerations)(x, np.zeros_like(x), acc, model.params, 1.0)
     return -(model.mass[model.held_idx] * acc[:, model.held_idx]).T
 
 

@@ -47,7 +47,7 @@ def test_the_lookup_finds_the_piece_a_walk_from_the_first_row_finds(gaps, data):
     probes = list(times) + [-0.5, times[-1] + 0.7] + data.draw(
         st.lists(st.floats(0.0, float(times[-1])), max_size=20))
     for t in probes:
-        s, ds, _ = offset(m, 0, 0, float(t))
+        s, ds, _ = offset(m, 0, 0, float(t), float(t))
         assert (s, ds) == _linear_walk(times, rows, float(t)), t
 
 
@@ -55,7 +55,7 @@ def test_the_lookup_finds_the_piece_a_walk_from_the_first_row_finds(gaps, data):
 def _lookups(m, t, n):
     total = 0.0
     for i in range(n):
-        total += offset(m, 0, 0, t + 1e-6 * i)[0]
+        total += offset(m, 0, 0, t + 1e-6 * i, t + 1e-6 * i)[0]
     return total
 
 
@@ -75,3 +75,14 @@ def test_a_lookup_late_in_a_long_path_costs_no_more_than_an_early_one():
     early = min(timed(1.0) for _ in range(3))
     late = min(timed(float(times[-2])) for _ in range(3))
     assert late < 50 * early + 0.1, (early, late)
+
+
+def test_a_stage_keeps_its_steps_piece_past_a_row():
+    """A stage of a step takes the piece holding the step's middle, extended beyond its rows: at the row that
+    ends the step it keeps the step's velocity (not the next piece's), and past it goes on in a straight line."""
+    m = _motion(np.array([0.0, 1.0, 2.0]), np.array([0.0, 2.0, 1.0]))
+    assert offset(m, 0, 0, 1.0, 0.95)[:2] == (2.0, 2.0)      # the last stage of the step ending on row 1
+    assert offset(m, 0, 0, 1.0, 1.05)[:2] == (2.0, -1.0)     # the first stage of the step starting there
+    assert offset(m, 0, 0, 1.0, 1.0)[:2] == (2.0, -1.0)      # a state at the row: on the path, the next piece
+    s, ds, _ = offset(m, 0, 0, 1.1, 0.95)                    # a Yoshida drift past the row: the same line
+    assert ds == 2.0 and abs(s - 2.2) < 1e-12

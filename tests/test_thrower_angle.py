@@ -155,7 +155,8 @@ def test_the_exact_contact_kick_solves_the_turned_box_exactly(angle):
     want = decay @ v[:, 0] + np.linalg.solve(a_mat, (np.eye(2) - decay) @ b)
     out, nodes = np.zeros((2, 1)), np.zeros(1, dtype=np.int64)
     params = model.params._replace(inv_mass=np.array([1.0 / 0.02]))
-    count = exact_contact_kicks(x, v, acc, out, nodes, tau, np.array([gamma]), np.array([True]), params)
+    kick = model.kernel(exact_contact_kicks)
+    count = kick(x, v, acc, out, nodes, tau, np.array([gamma]), np.array([True]), params)
     assert count == 1
     np.testing.assert_allclose(out[:, 0], want, rtol=1e-9)
 

@@ -5,6 +5,7 @@ A page asks for a generated part with an HTML comment on a line of its own:
     <!-- ropesim:scene rope -->     the [rope] table: heading, the dataclass's docstring, one row per key
     <!-- ropesim:scene rest -->     every table not placed earlier on the page, in the schema's order
     <!-- ropesim:cli run -->        the `ropesim run` command: summary, usage, arguments, options
+    <!-- ropesim:cli commands -->   a table of every command in its help panel, with its one-line summary
     <!-- ropesim:cli rest -->       every command not placed earlier on the page, in the app's order
 
 So a key, a table or a command added to the code appears in the docs without anyone editing a page, and a
@@ -339,12 +340,14 @@ def cli_section(name: str) -> str:
 
 
 def cli_summary_table() -> str:
-    """One row per command: its name (linked to its section) and the first line of its help."""
-    rows = ["| command | what it does |", "|---|---|"]
-    for name in cli_commands():
-        command, _ = _command(name)
+    """One row per command, grouped by its help panel (as `ropesim --help` shows them): the panel, its name
+    (linked to its section) and the first line of its help."""
+    rows = ["| group | command | what it does |", "|---|---|---|"]
+    commands = [(_command(name)[0], name) for name in cli_commands()]
+    panels = list(dict.fromkeys(command.rich_help_panel or "" for command, _ in commands))
+    for command, name in sorted(commands, key=lambda c: panels.index(c[0].rich_help_panel or "")):
         first = inspect.cleandoc(command.help or "").split("\n\n")[0].replace("\n", " ")
-        rows.append(f"| [`ropesim {name}`](#{name}) | {_cell(first)} |")
+        rows.append(f"| {command.rich_help_panel or ''} | [`ropesim {name}`](#{name}) | {_cell(first)} |")
     return "\n".join(rows)
 
 
@@ -385,14 +388,15 @@ def expand(markdown: str, where: str = "page") -> str:
     """Replace every ropesim marker of a page by its generated Markdown."""
     placed = {"scene": set(), "cli": set(), "api": set()}
     for kind, name in MARKER.findall(markdown):
-        placed[kind].add(name)
+        if (kind, name) != ("cli", "commands"):
+            placed[kind].add(name)
 
     def generate(match: re.Match) -> str:
         kind, name = match.group(1), match.group(2)
         if name == "rest":
             names = {"scene": scene_tables, "cli": cli_commands, "api": api_names}[kind]()
             return "\n\n".join(generate_one(kind, n) for n in names if n not in placed[kind])
-        if kind == "cli" and name == "summary":
+        if kind == "cli" and name == "commands":
             return cli_summary_table()
         return generate_one(kind, name)
 

@@ -5,7 +5,7 @@ weight, buoyancy, springs, bending, the seabed's contact, drag in the flow at it
 scene's initial shape, the held nodes where the scene holds them at t = 0, and reports:
 
 - ``supports``: the force [N] each support exerts on its held node, minus the net force of the other terms
-  on it at rest (so a fairlead's is the line's pull on the vessel, reversed);
+  on it at rest (the flow's push on the linear [drag] included) (so a fairlead's is the line's pull on the vessel, reversed);
 - ``tension``: each segment's axial force [N] (spring and damping, zero in a slack segment);
 - with a ``[seabed]``: the nodes resting on it (sunk below its plane), the length of rope they carry, and the
   touchdown point, the grounded node next to the suspended part.
@@ -45,20 +45,23 @@ def equilibrium(scene: S.Scene) -> StaticShape:
     model = build(scene, solve=False)
     result = solve_equilibrium(model)
     x = np.ascontiguousarray(result.x)
-    supports, tension = _loads(model, x)
+    supports, tension = static_loads(model, x)
     grounded, length, touchdown = _on_the_seabed(model, x)
     return StaticShape(model, x.T.copy(), result.residual, result.scale, result.iterations, result.converged,
                        model.held_idx.copy(), supports, tension, grounded, length, touchdown)
 
 
-def _loads(model: Model, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def static_loads(model: Model, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The support forces (H, D) [N] and segment tensions [N] of the nodes at rest at ``x`` (D, N)."""
     from ..model.forces.springs import segment_forces
+    from ..model.tension import held_linear_drag
     from ..model.terms import accelerations
 
     v, acc = np.zeros_like(x), np.zeros_like(x)
-    accelerations(x, v, acc, model.params, _steady_time(model.scene))
+    t = _steady_time(model.scene)
+    model.kernel(accelerations)(x, v, acc, model.params, t)
     idx = model.held_idx
-    supports = -(model.mass[idx][:, None] * acc[:, idx].T)
+    supports = -(model.mass[idx][:, None] * acc[:, idx].T + held_linear_drag(model, t, x, v))
     tension = segment_forces(model, x.T[None], v.T[None])[0]
     return supports, tension
 

@@ -22,8 +22,14 @@ def block_frames(frame_nbytes: int, block: int | None = None) -> int:
     return max(1, min(block or FRAME_BLOCK, BLOCK_BYTES // max(1, frame_nbytes)))
 
 
+def clean_time(t: float) -> float:
+    """A frame time [s] without the float noise of k * interval (20.900000000000002 -> 20.9): 12 digits."""
+    return float(f"{float(t):.12g}")
+
+
 def largest_stretch(model: Model, x: np.ndarray) -> tuple[float, float]:
-    """The largest relative spring stretch |r| / l - 1 over all saved frames, and the time index it occurs."""
+    """The largest relative spring stretch |r| / l - 1 over all saved frames (a peak between two frames is not
+    seen), and the frame index where it occurs."""
     rope = model.scene.rope
     best, where = -np.inf, 0
     block = block_frames(x[0].nbytes)
@@ -47,7 +53,7 @@ def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray
         "scene": scene.name,
         "ropesim_version": __version__,
         "status": outcome.status,
-        "t_end": float(t[-1]),
+        "t_end": clean_time(t[-1]),
         "t_end_requested": scene.integrator.t_end,
         "method": scene.integrator.method,
         "dt": grid.dt,
@@ -88,8 +94,8 @@ def _physics_figures(model: Model, t: np.ndarray, x: np.ndarray, v: np.ndarray) 
     stretch, at = largest_stretch(model, x)
     out: dict = {
         "final_energy_J": {k: float(val) for k, val in energy.items()},
-        "max_spring_stretch": stretch,
-        "max_spring_stretch_t": float(t[at]),
+        "max_spring_stretch": stretch,        # a fraction of the rest length (0.01 is 1 %), over the saved frames
+        "max_spring_stretch_t": clean_time(t[at]),
     }
     if towed_end(scene) is not None:
         out["towed"] = towed_figures(model, x[-1])

@@ -28,5 +28,69 @@ def tension_figures(t: np.ndarray, tension: np.ndarray, block: int) -> dict:
         "start_N": float(last[0]), "end_N": float(last[-1]),
         "start_min_N": start_range[0], "start_max_N": start_range[1],
         "end_min_N": end_range[0], "end_max_N": end_range[1],
-        "max_N": best, "max_segment": where, "max_t_s": float(t[when]),
+        "max_N": best, "max_segment": where, "max_t_s": float(f"{float(t[when]):.12g}"),
     }
+
+
+KILO = 1e3
+
+
+def force_unit(largest: float) -> tuple[str, float]:
+    """("kN", 1000) where forces reach kilonewtons (``largest`` [N] at least 1000), else ("N", 1)."""
+    return ("kN", KILO) if abs(largest) >= KILO else ("N", 1.0)
+
+
+def frame_window(t: np.ndarray, start: float | None = None, stop: float | None = None) -> slice:
+    """The frames with start <= t <= stop (either end open when None), as a slice; ValueError (one line naming
+    --from/--to and the run's span) when none is left."""
+    t = np.asarray(t)
+    lo = 0 if start is None else int(np.searchsorted(t, start - 1e-9 * max(1.0, abs(start)), side="left"))
+    hi = len(t) if stop is None else int(np.searchsorted(t, stop + 1e-9 * max(1.0, abs(stop)), side="right"))
+    if (start is not None and stop is not None and stop < start) or hi <= lo:
+        raise ValueError(f"--from {start if start is not None else t[0]:g} --to {stop if stop is not None else t[-1]:g}: "
+                         f"no saved frame in that window; the run has frames from t = {float(t[0]):g} to "
+                         f"{float(t[-1]):g} s")
+    return slice(lo, hi)
+
+
+def window_statistics(values, frames: slice, block: int = 256) -> dict[str, np.ndarray]:
+    """min, max, mean and std (population) over the frames ``frames`` of ``values`` (F, ...) per entry, read
+    ``block`` frames at a time (a memory-mapped run of any length): two passes, the second about the mean."""
+    lo, hi = frames.start, frames.stop
+    count = hi - lo
+    low = high = total = None
+    for s in range(lo, hi, block):
+        part = np.asarray(values[s:min(hi, s + block)], dtype=float)
+        low = part.min(axis=0) if low is None else np.minimum(low, part.min(axis=0))
+        high = part.max(axis=0) if high is None else np.maximum(high, part.max(axis=0))
+        total = part.sum(axis=0) if total is None else total + part.sum(axis=0)
+    mean = total / count
+    spread = np.zeros_like(mean)
+    for s in range(lo, hi, block):
+        part = np.asarray(values[s:min(hi, s + block)], dtype=float)
+        spread += ((part - mean) ** 2).sum(axis=0)
+    return {"min": low, "max": high, "mean": mean, "std": np.sqrt(spread / count)}
+
+
+def windowed_figures(traj, start: float | None = None, stop: float | None = None) -> dict:
+    """The tension and support figures of a run over the window [start, stop] [s] (the whole run by default):
+    per segment min / max / mean / std of tension [N], the two end tensions' and each support force
+    magnitude's, the largest tension with where and when, and the unit to print them in."""
+    frames = frame_window(traj.t, start, stop)
+    t = np.asarray(traj.t[frames])
+    along = window_statistics(traj.tension, frames)
+    k, j = np.unravel_index(int(np.argmax(np.asarray(traj.tension[frames]))), (len(t), traj.tension.shape[1]))
+    out = {"from_s": float(f"{float(t[0]):.12g}"), "to_s": float(f"{float(t[-1]):.12g}"), "frames": int(len(t)),
+           "segments": {name: values.tolist() for name, values in along.items()},
+           "start": {name: float(values[0]) for name, values in along.items()},
+           "end": {name: float(values[-1]) for name, values in along.items()},
+           "max_N": float(traj.tension[frames.start + k, j]), "max_segment": int(j),
+           "max_t_s": float(f"{float(t[k]):.12g}")}
+    largest = float(np.max(np.abs(along["max"])))
+    if traj.support is not None:
+        magnitude = np.linalg.norm(np.asarray(traj.support[frames]), axis=2)
+        stats = window_statistics(magnitude, slice(0, len(t)))
+        out["supports"] = [{name: float(values[h]) for name, values in stats.items()} for h in range(magnitude.shape[1])]
+        largest = max(largest, float(stats["max"].max()))
+    out["unit"] = force_unit(largest)[0]
+    return out

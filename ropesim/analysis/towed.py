@@ -21,9 +21,10 @@ STRAIGHT_TOLERANCE_DEG = 1.0
 def towed_end(scene: Scene) -> int | None:
     """The held end of a towed rope (0 or N-1), or None if the scene is not one.
 
-    A towed rope is an open line with exactly one held node, at one of its ends, and no bending (neither
-    [bending] nor rope.EI), thrower, guides, seabed, moving drive or fluid terms but the linear [drag] (so the
-    steady state above is exact).
+    A towed rope is an open line with exactly one held node, at one of its ends, driven at a constant nonzero
+    velocity (a pin is not a tow: a chain let go from a pin swings, and its steady state, hanging straight
+    down, says nothing of it), and no bending (neither [bending] nor rope.EI), thrower, guides, seabed,
+    moving drive or fluid terms but the linear [drag] (so the steady state above is exact).
     """
     n = scene.rope.nodes
     held = [scene.node(i) for i in (scene.pinned.nodes if scene.pinned else ())]
@@ -37,6 +38,8 @@ def towed_end(scene: Scene) -> int | None:
         return None   # a bending rope (a cantilever) holds a shape the steady state above knows nothing of
     if any(drive.moving for drive in scene.driven):
         return None   # the steady state needs a constant tow velocity
+    if not any(any(drive.velocity) for drive in scene.driven):
+        return None   # pinned, or driven at rest: nothing tows it
     if any(getattr(scene, part) is not None for part in ("flow", "fluid_drag", "viscous_drag", "buoyancy",
                                                           "added_mass")) or scene.bodies:
         return None   # the closed form below is for linear drag in still air; see tests/references/towed_cable.py

@@ -88,7 +88,7 @@ app = typer.Typer(
          "A scene is a TOML file or the name of a built-in scene (`ropesim scenarios` lists them). Start with:\n\n"
          "  ropesim run helicopter_mass",
     no_args_is_help=True,
-    add_completion=False,
+    add_completion=True,    # --install-completion / --show-completion for bash, zsh, fish and PowerShell
     pretty_exceptions_enable=False,
     context_settings={"help_option_names": ["-h", "--help"]},
 )
@@ -104,6 +104,23 @@ def exit_code(exc: BaseException | None = None, name: str = "") -> int:
     if isinstance(exc, Stopped):
         name = exc.name
     return SIGNAL_EXIT.get(name, EXIT_INTERRUPTED)
+
+RUNNING, SCENES, PICTURES, STUDIES = "Run and check", "Scenes and set-up", "Pictures and exports", "Studies"
+"""The help panels the commands are grouped in (`ropesim --help`)."""
+
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print the result as one JSON object on stdout (for "
+                                                       "scripts), instead of the table.")]
+FromOpt = Annotated[Optional[float], typer.Option("--from", metavar="T", help="Leave out the frames before T "
+                                                  "seconds (a ramp-in, a transient).", show_default=False)]
+ToTimeOpt = Annotated[Optional[float], typer.Option("--to", metavar="T", help="Leave out the frames after T "
+                                                    "seconds.", show_default=False)]
+
+
+def _echo_json(data: dict) -> None:
+    import json
+
+    typer.echo(json.dumps(data, indent=2, allow_nan=False, default=float))
+
 
 SceneArg = Annotated[str, typer.Argument(
     metavar="SCENE", help="A scene file (TOML), or the name of a built-in scene such as helicopter_mass "
@@ -163,7 +180,7 @@ def _load(scene: str, sets: list[str] | None):
         fail(str(exc))
 
 
-@app.command(cls=Command)
+@app.command(cls=Command, rich_help_panel=RUNNING)
 def run(
     scene_file: Annotated[Optional[str], typer.Argument(
         metavar="SCENE", help="A scene file (TOML), or the name of a built-in scene such as helicopter_mass "
@@ -327,6 +344,8 @@ def _check_size(scene, where: str, folder: Path, force: bool, quiet: bool) -> No
 
 
 def _duration(seconds: float) -> str:
+    if seconds < 1:
+        return "under a second"
     if seconds < 120:
         return f"{seconds:.0f} s"
     if seconds < 7200:
@@ -353,20 +372,30 @@ def _check_time_step(scene, where: str, force: bool, quiet: bool) -> None:
                    f"(warning above {WARN_FRACTION:.0%})", err=True)
 
 
-@app.command(cls=Command)
-def check(scene_file: SceneArg, sets: SetOpt = None) -> None:
+@app.command(cls=Command, rich_help_panel=RUNNING)
+def check(scene_file: SceneArg, sets: SetOpt = None, as_json: JsonOpt = False) -> None:
     """Validate a scene and show what it contains and its stability bound, without running it."""
-    from .report import print_check
+    from .report import check_data, print_check
 
     from ..io.runfolder import free_bytes, human
     from ..run import WARN_BYTES, WARN_SECONDS, estimate
 
     scene, where = _load(scene_file, sets)
-    print_check(scene, where)
     est, folder = estimate(scene), Path("runs") / scene.name
     free = free_bytes(folder)
+    if as_json:
+        from ..kernels import loop_cached
+
+        _echo_json({**check_data(scene, where), "output": {
+            "frames": est.frames, "bytes": est.bytes, "peak_bytes": est.peak_bytes, "free_bytes": free,
+            "folder": str(folder), "run_seconds": est.seconds,
+            "kernel_cached": loop_cached(scene)}})
+        return
+    print_check(scene, where)
     typer.echo(f"output: about {human(est.bytes)} in {est.frames:,} frames ({human(est.peak_bytes)} while the "
-               f"run finishes; {human(free)} free at {folder}); run time about {_duration(est.seconds)}")
+               f"run finishes; {human(free)} free at {folder}); run time {'about ' * (est.seconds >= 1)}"
+               f"{_duration(est.seconds)}"
+               f"{_compile_note(scene)}")
     if est.peak_bytes > free:
         typer.echo(f"ropesim: warning: {where}: the disk at {folder} cannot hold the frames; `ropesim run` "
                    f"refuses it without --force", err=True)
@@ -375,8 +404,54 @@ def check(scene_file: SceneArg, sets: SetOpt = None) -> None:
                    err=True)
 
 
-@app.command(cls=Command, name="compile")
+def _compile_note(scene) -> str:
+    """What a first run adds to the run time: compiling the method's loop, unless Numba's cache has it."""
+    from ..kernels import FIRST_COMPILE_SECONDS, loop_cached
+
+    method = scene.integrator.method
+    cached = loop_cached(scene)
+    if cached:
+        return f" ({method}'s kernel is in the cache: no compiling)"
+    low, high = FIRST_COMPILE_SECONDS
+    return (f", after compiling {method}'s kernel{' once' if cached is False else ', if not in the cache'} "
+            f"({low} to {high} s; `ropesim compile` does it ahead)")
+
+
+@app.command(cls=Command, rich_help_panel=RUNNING)
+def summary(
+    run_dir: Annotated[Path, typer.Argument(metavar="RUN_DIR", help="Run folder written by `ropesim run`, e.g. "
+                                                                    "runs/mooring_chain.", show_default=False)],
+    start: FromOpt = None,
+    stop: ToTimeOpt = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """A run's tensions and support forces over a window of time: min, max, mean and std of the tension at both
+    ends and of each support's force, and the largest tension anywhere, in kN where forces reach kilonewtons.
+
+    --from leaves out a ramp-in or a start-up transient; summary.json keeps the whole run's figures.
+    """
+    from .report import print_window
+    from ..analysis.tension import windowed_figures
+
+    traj = _open_run(run_dir, "summary")
+    if traj.tension is None:
+        fail(f"{run_dir}: stores no tensions (written by an older ropesim); run it again")
+    try:
+        figures = windowed_figures(traj, start, stop)
+    except ValueError as exc:
+        fail(str(exc))
+    if as_json:
+        _echo_json({"run": str(run_dir), **figures})
+    else:
+        print_window(figures, run_dir)
+
+
+@app.command(cls=Command, rich_help_panel=SCENES, name="compile")
 def compile_(
+    scene_files: Annotated[Optional[list[str]], typer.Argument(
+        metavar="[SCENE]...", help="Compile for these scenes (built-in names or scene files; default: every "
+                                   "built-in scene).", show_default=False)] = None,
+    sets: SetOpt = None,
     methods: Annotated[Optional[list[str]], typer.Option(
         "--method", "-m", metavar="NAME", help="Compile only this integrator's kernels; repeatable or "
                                                "comma-separated (default: every integrator, and the static "
@@ -385,17 +460,20 @@ def compile_(
 ) -> None:
     """Compile every kernel into Numba's cache now, so that later runs start at once: for container images and CI.
 
-    A run compiles its integrator's time loop the first time (8 to 30 s, once; then it loads from the cache
-    in a fraction of a second). This compiles the loop of every integrator for every built-in scene, the
-    tension and support forces of a saved frame, and the static solver of initial.shape = "equilibrium", then
-    prints what it compiled and how long each took. The cache is the folder ropesim chose for this
-    installation (or NUMBA_CACHE_DIR): run it as the user who will run ropesim, on the same kind of CPU.
+    A scene compiles only the parts it uses, the first time it runs (a few seconds, once; then it loads from
+    the cache in a fraction of a second). This compiles the loop of every integrator for every built-in scene
+    (or the scenes given), the tension and support forces of a saved frame, and the static solver of
+    `ropesim equilibrium`, then prints what it compiled and how long each took. A scene of your own with parts
+    no built-in scene combines compiles its own copy: name it here to prepare it too. The cache is the folder
+    ropesim chose for this installation (or NUMBA_CACHE_DIR): run it as the user who will run ropesim, on the
+    same kind of CPU.
     """
     from .report import print_compiled
     from .status import Startup, cache_dir
     from ..kernels import STATIC_SOLVER, compile_all
 
     names = _methods(",".join(methods), "--method") if methods else None
+    scenes = [_load(name, sets)[0] for name in scene_files] if scene_files else None
     with Startup(not quiet and sys.stderr.isatty(), "ropesim compile") as status:
         status.watch()
 
@@ -403,12 +481,12 @@ def compile_(
             what = "the static solver" if name == STATIC_SOLVER else f"the {name} kernel"
             status.update(f"Loading {what} ({i + 1} of {n})", kernel=what)
 
-        results = compile_all(names, static_solver=names is None, on_start=starting)
+        results = compile_all(names, scenes, static_solver=names is None, on_start=starting)
     if not quiet:
-        print_compiled(results, cache_dir())
+        print_compiled(results, cache_dir(), builtin=scenes is None)
 
 
-@app.command(cls=Command)
+@app.command(cls=Command, rich_help_panel=RUNNING)
 def equilibrium(
     scene_file: SceneArg,
     sets: SetOpt = None,
@@ -417,6 +495,7 @@ def equilibrium(
                                                   "(every node at rest), to run or to edit.",
         show_default=False)] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace FILE.toml if it exists.")] = False,
+    as_json: JsonOpt = False,
 ) -> None:
     """Find a scene's static shape: every force balanced at every free node, the held nodes where the scene holds
     them; print the support forces, the tensions and what rests on the seabed.
@@ -425,7 +504,7 @@ def equilibrium(
     weight, buoyancy, the springs, bending, the seabed's contact and drag in the flow at its full strength. A
     scene with initial.shape = "equilibrium" starts its runs from this shape. Exit 1 if it does not converge.
     """
-    from .report import print_equilibrium
+    from .report import equilibrium_data, print_equilibrium
     from ..analysis.statics import as_points_scene, equilibrium as solve
     from ..io.atomic import write_text_atomic
     from ..scene.schema import scene_to_toml
@@ -439,7 +518,10 @@ def equilibrium(
         target = _may_write(lambda: output_file(out, replace=force, force_hint=True))
     with _compiling():   # the static solver compiles on its first use
         shape = solve(scene)
-    print_equilibrium(shape, where)
+    if as_json:
+        _echo_json(equilibrium_data(shape, where))
+    else:
+        print_equilibrium(shape, where)
     if not shape.converged:
         fail(f"{where}: the static solve did not converge (largest residual force {shape.residual:.3g} N after "
              f"{shape.iterations} iterations); check that the rope can hang where the scene holds it", 1)
@@ -448,10 +530,10 @@ def equilibrium(
             write_text_atomic(target, scene_to_toml(as_points_scene(shape)))
         except OSError as exc:
             fail(_write_failure(exc, out), EXIT_WRITE)
-        typer.echo(f"written: {out} (run it with `ropesim run {out}`)")
+        typer.echo(f"written: {out} (run it with `ropesim run {out}`)", err=as_json)
 
 
-@app.command(cls=Command)
+@app.command(cls=Command, rich_help_panel=SCENES)
 def scenarios() -> None:
     """List the built-in scenes, one a line: the name to give `ropesim run` and what the scene shows."""
     from ..scene.builtin import builtin_names, builtin_path, describe
@@ -462,7 +544,7 @@ def scenarios() -> None:
         typer.echo(f"{name:<{width}}  {describe(builtin_path(name))}")
 
 
-@app.command(cls=Command)
+@app.command(cls=Command, rich_help_panel=SCENES)
 def new(
     name: Annotated[str, typer.Argument(metavar="NAME", help="The new scene's name; it is written to NAME.toml "
                                                              "(or give a path ending in .toml).",
@@ -496,7 +578,7 @@ def new(
                f"`ropesim run {target}`")
 
 
-@app.command(cls=Command)
+@app.command(cls=Command, rich_help_panel=STUDIES)
 def sweep(
     scene_file: SceneArg,
     sets: Annotated[Optional[list[str]], typer.Option(
@@ -640,6 +722,14 @@ def _open_run(run_dir: Path, command: str):
         fail(str(exc))
 
 
+def _formats(incomplete: str) -> list[str]:
+    """``--to``'s fixed choices, for shell completion; any other value is refused by the command in one line that
+    says why (NetCDF is not offered, and what to use instead)."""
+    from ..io.export import FORMATS
+
+    return [f for f in FORMATS if f.startswith(incomplete.lower())]
+
+
 def _picture(make, what: str = "picture"):
     """Call ``make()``: an unusable run folder or request, or an output that is not ropesim's to replace, prints
     one line and exits 2; an output that cannot be written (a full disk, a read-only folder) one line naming it,
@@ -679,7 +769,7 @@ def _animate(run_dir: Path, out: Optional[Path], quiet: bool, **options) -> None
                    f"{result.size[0]}x{result.size[1]} px")
 
 
-@app.command(cls=Command)
+@app.command(cls=Command, rich_help_panel=PICTURES)
 def animate(
     run_dir: RunDirArg,
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output file, .gif or .mp4 (default "
@@ -702,7 +792,7 @@ def animate(
     _animate(run_dir, out, quiet, fps=fps, speed=speed, start=start, end=end, follow=follow, view=view, size=size)
 
 
-@app.command(cls=Command)
+@app.command(cls=Command, rich_help_panel=PICTURES)
 def frames(
     run_dir: RunDirArg,
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output PNG (default RUN_DIR/frames.png).",
@@ -741,11 +831,13 @@ def frames(
                    f"{result.size[0]}x{result.size[1]} px")
 
 
-@app.command(cls=Command)
+@app.command(cls=Command, rich_help_panel=PICTURES)
 def plot(
     run_dir: RunDirArg,
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output PNG (default RUN_DIR/plots.png).",
                                                 show_default=False)] = None,
+    start: FromOpt = None,
+    stop: ToTimeOpt = None,
     quiet: QuietOpt = False,
 ) -> None:
     """Plot a run: energy and largest spring stretch over time, and the towed rope's angle or the shooter's loop.
@@ -756,31 +848,40 @@ def plot(
     from ..render.plots import plot_run
     traj = _open_run(run_dir, "plot")
     target = out if out is not None else run_dir / "plots.png"
-    result = _picture(lambda: plot_run(traj, target))
+    result = _picture(lambda: plot_run(traj, target, start=start, stop=stop))
     if not quiet:
         typer.echo(f"{result.path}: {', '.join(result.panels)}")
 
 
-@app.command(cls=Command)
+@app.command(cls=Command, rich_help_panel=PICTURES)
 def export(
     run_dir: RunDirArg,
-    to: Annotated[str, typer.Option("--to", "-t", metavar="FORMAT", help="vtk: a series for ParaView (a .pvd and a "
-                                    ".vtu per frame; needs the export extra); csv: one table for spreadsheets.",
-                                    show_default=False)],
+    to: Annotated[str, typer.Option("--to", "-t", metavar="[vtk|csv]", autocompletion=_formats,
+                                    help="vtk: a series for ParaView (a .pvd and a .vtu per frame; needs the export "
+                                         "extra); csv: tables for spreadsheets.", show_default=False)],
     out: Annotated[Optional[Path], typer.Option(
         "--out", "-o", help="Output: a folder for vtk, a file for csv (default RUN_DIR/vtk/ or "
                             "RUN_DIR/trajectory.csv).", show_default=False)] = None,
+    start: FromOpt = None,
+    stop: Annotated[Optional[float], typer.Option("--until", metavar="T", help="Leave out the frames after T "
+                                                  "seconds (--to names the format here).", show_default=False)] = None,
     quiet: QuietOpt = False,
 ) -> None:
     """Export a run for the tools engineers use: a VTK series for ParaView, or CSV for spreadsheets.
 
     vtk: one .vtu per saved frame (the nodes joined by line cells, with velocity and speed per node) and a .pvd
-    that lists them with their times: open the .pvd in ParaView and press play. Written with meshio (pip
-    install 'ropesim[export]'): 2 MB of pure Python that writes VTK's compressed XML correctly; pyvista would
+    that lists them with their times: open the .pvd in ParaView and press play. Written with meshio (the export
+    extra: pip install 'pyropesim[export]', or pip install -e '.[export]' in a checkout): 2 MB of pure Python that writes VTK's compressed XML correctly; pyvista would
     bring all of VTK.
 
+    vtk also carries each segment's tension [N] and strain as cell data, and the supports as a point set with
+    their forces [N] (part 1 of each time step).
+
     csv: long format, one row per node per frame, a header naming each column with its unit (t [s], node,
-    x [m], y [m], vx [m/s], vy [m/s]); full precision, so it reads back exactly.
+    x [m], y [m], vx [m/s], vy [m/s]); full precision, so it reads back exactly. Beside it
+    STEM_tension_history.csv (per frame: the end tensions and every support's force) and
+    STEM_tension_range.csv (per segment: min, max, mean and std of its tension), in kN where forces reach
+    kilonewtons; --from/--until keep a window (leave the ramp-in out).
 
     NetCDF is not offered: xarray with h5py would add about 120 MB to hold the three arrays trajectory.npz
     already holds (numpy.load reads it; xarray wraps it in one call).
@@ -789,11 +890,11 @@ def export(
 
     traj = _open_run(run_dir, "export")
     try:
-        result = _picture(lambda: write(traj, to.strip().lower(), out), "export")
+        result = _picture(lambda: write(traj, to.strip().lower(), out, start=start, stop=stop), "export")
     except ExportError as exc:
         fail(str(exc))
     if not quiet:
-        typer.echo(f"{result.path}: {traj.frames} frames of {traj.nodes} nodes, {result.files} "
+        typer.echo(f"{result.path}: {result.frames} frames of {traj.nodes} nodes, {result.files} "
                    f"file{'s' if result.files > 1 else ''}, {result.bytes / 1e3:,.0f} kB")
 
 
@@ -842,7 +943,7 @@ def _numbers(text: str | None, option: str) -> list[float] | None:
     return values
 
 
-@app.command(cls=Command)
+@app.command(cls=Command, rich_help_panel=STUDIES)
 def accuracy(
     scene_file: SceneArg,
     methods: MethodsOpt = None,
@@ -897,7 +998,7 @@ def _analysis_files(folder: Path, *names: str) -> list[Path]:
     return [output_file(real / name, option="--out") for name in names]
 
 
-@app.command(cls=Command)
+@app.command(cls=Command, rich_help_panel=STUDIES)
 def stability(
     scene_file: SceneArg,
     methods: MethodsOpt = None,

@@ -48,8 +48,9 @@ def print_figures(console: Console, title: str, columns: list[str], rows: list[l
         console.print(table)
 
 
-def print_compiled(results, cache: str) -> None:
-    """What ``ropesim compile`` did, per integrator (and the static solver): time and functions compiled."""
+def print_compiled(results, cache: str, builtin: bool = True) -> None:
+    """What ``ropesim compile`` did, per integrator (and the static solver): time and functions compiled, for the
+    built-in scenes (``builtin``) or the scenes given."""
     rows = []
     for r in results:
         if r.functions:
@@ -63,8 +64,10 @@ def print_compiled(results, cache: str) -> None:
     print_figures(console, f"kernels in {cache}", ["kernel", "family", "time [s]", "what happened"], rows, keys=1,
                   left=(0, 1, 3))
     scenes = max((r.scenes for r in results if r.family != "statics"), default=0)
-    console.print(f"each integrator made ready for {scenes} built-in scene{'s' if scenes != 1 else ''} (its loop "
-                  f"serves every scene): runs load it from the cache instead of compiling")
+    which = "built-in scene" if builtin else "scene"
+    console.print(f"each integrator made ready for {scenes} {which}{'s' if scenes != 1 else ''}: their runs load it "
+                  f"from the cache instead of compiling (a scene with other parts compiles its own on its first "
+                  f"run; name it to `ropesim compile` to prepare it now)")
 
 
 def print_summary(summary: dict, folder: Path) -> None:
@@ -87,8 +90,9 @@ def print_summary(summary: dict, folder: Path) -> None:
     energy = summary.get("final_energy_J")
     if energy:
         rows.append(("final energy", ", ".join(f"{k} {v:.6g} J" for k, v in energy.items())))
-        rows.append(("largest stretch", f"{100 * summary['max_spring_stretch']:.3g} % "
-                                        f"(at t = {summary['max_spring_stretch_t']:.3g} s)"))
+        rows.append(("largest stretch", f"{100 * summary['max_spring_stretch']:.3g} % of the rest length "
+                                        f"(max_spring_stretch {summary['max_spring_stretch']:.3g}; over the saved "
+                                        f"frames, at t = {summary['max_spring_stretch_t']:.3g} s)"))
     towed = summary.get("towed")
     if towed:
         rows.append(("rope angle", f"top {towed['top_angle_deg']:.2f} deg, bottom {towed['bottom_angle_deg']:.2f} "
@@ -241,13 +245,15 @@ def _seabed_text(bed) -> str:
 def _motion_text(drive) -> str:
     """How a driven node moves: its constant velocity, and its sinusoid and path, ramped in."""
     parts = [f"at {list(drive.velocity)} m/s"] if any(drive.velocity) or not drive.moving else []
-    if drive.amplitude is not None:
-        axes = [f"{'xyz'[k]} {a:g} m, {drive.period[k]:g} s" + (f", {drive.phase[k]:g} deg" if drive.phase[k] else "")
-                for k, a in enumerate(drive.amplitude) if a]
+    axes = [f"{'xyz'[k]} {a:g} m, {drive.period[k]:g} s" + (f", {drive.phase[k]:g} deg" if drive.phase[k] else "")
+            for k, a in enumerate(drive.amplitude or ()) if a]
+    if axes:
         parts.append("sinusoid " + "; ".join(axes))
     if drive.path_table is not None:
         parts.append(f"a path of {len(drive.path_table)} rows")
-    ramp = f", ramped in over {drive.ramp_time:g} s" if drive.moving and drive.ramp_time else ""
+    if not parts:
+        return "held still (every amplitude is 0)"
+    ramp = f", ramped in over {drive.ramp_time:g} s" if (axes or drive.path_table is not None) and drive.ramp_time else ""
     return " + ".join(parts) + ramp
 
 
@@ -390,3 +396,73 @@ def print_equilibrium(shape, source: str) -> None:
 
 def _point(p) -> str:
     return "(" + ", ".join(f"{float(c):.6g}" for c in p) + ")"
+
+
+def check_data(scene: Scene, source) -> dict:
+    """What ``ropesim check --json`` prints: the scene's make-up and every method's stability bound."""
+    from ..analysis.stability import bounds
+    from ..integrate.grid import TimeGrid
+    from ..model.build import build
+
+    model = build(scene)
+    grid = TimeGrid.of(scene)
+    rope = scene.rope
+    omega_gershgorin, omega, rows = bounds(model)
+    held = []
+    if scene.pinned:
+        held += [{"kind": "pinned", "nodes": list(scene.pinned.nodes)}]
+    held += [{"kind": "driven", "nodes": list(d.nodes), "motion": _motion_text(d)} for d in scene.driven]
+    return {
+        "source": str(source), "valid": True, "scene": scene.name, "description": scene.description,
+        "dimension": scene.dimension, "nodes": rope.nodes, "closed": rope.closed,
+        "segment_length_m": rope.segment_length, "stiffness_N_per_m": rope.stiffness, "node_mass_kg": rope.mass,
+        "force_terms": force_terms(scene, model), "held": held,
+        "method": scene.integrator.method, "dt_s": grid.dt, "t_end_s": scene.integrator.t_end,
+        "steps": grid.steps, "frames": grid.frames,
+        "omega_max_rad_per_s": omega if omega_gershgorin > 0 else None,
+        "stable_dt_s": {b.method: (None if b.dt_spectral == float("inf") else b.dt_spectral) for b in rows},
+    }
+
+
+def equilibrium_data(shape, source: str) -> dict:
+    """What ``ropesim equilibrium --json`` prints: the figures of :func:`print_equilibrium`, in SI units."""
+    import numpy as np
+
+    model, x = shape.model, shape.x
+    scene = model.scene
+    pinned = {scene.node(i) for i in scene.pinned.nodes} if scene.pinned else set()
+    out = {
+        "source": source, "converged": bool(shape.converged), "iterations": int(shape.iterations),
+        "residual_N": float(shape.residual), "force_scale_N": float(shape.scale),
+        "supports": [{"node": int(node), "kind": "pinned" if node in pinned else "driven",
+                      "position_m": [float(c) for c in x[node]], "force_N": [float(f) for f in force],
+                      "magnitude_N": float(np.linalg.norm(force))}
+                     for node, force in zip(shape.held, shape.supports)],
+        "tension_N": [float(f) for f in shape.tension],
+        "positions_m": [[float(c) for c in row] for row in x],
+    }
+    if scene.seabed is not None:
+        out["seabed"] = {"grounded_nodes": [int(i) for i in shape.grounded],
+                         "grounded_length_m": float(shape.grounded_length),
+                         "touchdown_node": None if shape.touchdown is None else int(shape.touchdown)}
+    return out
+
+
+def print_window(figures: dict, folder) -> None:
+    """``ropesim summary``: a run's tension and support figures over a window of time, in N or kN."""
+    from ..analysis.tension import force_unit
+
+    unit, scale = force_unit(1e3 if figures["unit"] == "kN" else 0.0)
+    console = _console()
+    console.print(f"{folder}: t = {figures['from_s']:g} .. {figures['to_s']:g} s ({figures['frames']} frames)")
+
+    def row(name, stats):
+        return [name, *(f"{stats[k] / scale:.4g}" for k in ("min", "max", "mean", "std"))]
+
+    rows = [row("segment 0 (node 0's end)", figures["start"]), row("last segment", figures["end"])]
+    for h, stats in enumerate(figures.get("supports", [])):
+        rows.append(row(f"support {h}: |F|", stats))
+    columns = ["", f"min\n[{unit}]", f"max\n[{unit}]", f"mean\n[{unit}]", f"std\n[{unit}]"]
+    print_figures(console, "tension and support forces", columns, rows, keys=1)
+    console.print(f"largest tension {figures['max_N'] / scale:.4g} {unit} in segment {figures['max_segment']} at "
+                  f"t = {figures['max_t_s']:g} s")

@@ -228,8 +228,10 @@ class Startup:
         return self
 
     def _started(self, func) -> None:
+        from ..model.jit import template_name
+
         # Numba compiles under one global lock, so the events of every thread nest properly.
-        module, name = getattr(func, "__module__", "") or "", getattr(func, "__qualname__", "?")
+        module, name = getattr(func, "__module__", "") or "", template_name(getattr(func, "__qualname__", "?"))
         ours = module.startswith("ropesim")
         self._stack.append(name if ours else "")
         self._depth += 1

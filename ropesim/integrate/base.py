@@ -19,11 +19,16 @@ coefficients, a Runge-Kutta method's Butcher table), its order and a line of doc
    ``exact_contact_kicks`` (the thrower's and guides' damping is integrated exactly) and
    ``unconditionally_stable``.
 2. An :class:`Integrator` subclass whose ``__init__(model, grid, method)`` calls ``super().__init__`` (which
-   sets x, v, the ledger, the health limits, the held nodes and the step counter) and builds the family's
-   own state and scratch arrays from the :class:`~ropesim.model.build.Model`, and which provides:
+   sets x, v, the ledger, the health limits, the held nodes, the step counter and the compile-time switches)
+   and builds the family's own state and scratch arrays from the :class:`~ropesim.model.build.Model`, and
+   which provides:
 
-   - :meth:`Integrator._run` ``(n, frames)``: call the family's compiled loop for ``n`` steps from
-     ``self.step``, returning ``(steps done, frames written, status, node)``;
+   - :meth:`Integrator.template`: its compiled loop (a template, see :func:`ropesim.model.jit.specialise`),
+     and, if the family adds compile-time switches of its own to the model's (its terms, prescribed motion),
+     :meth:`Integrator.switches_for` (the splitting family's plain stage). ``super().__init__`` sets
+     ``self.loop``, the loop's copy for this run's switches;
+   - :meth:`Integrator._run` ``(n, frames)``: call ``self.loop`` for ``n`` steps from ``self.step``, returning
+     ``(steps done, frames written, status, node)``;
    - :attr:`Integrator.force_evaluations`: force evaluations so far (Newton iterations for an implicit
      method);
    - ``STATE``: the names of its attributes (arrays, updated in place) that, with x, v, the ledger and the
@@ -63,6 +68,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..model.jit import specialise
 from ..model.motion import place_moving
 from .health import LEDGER_COLUMNS, OK, initial_ledger, limits
 
@@ -177,11 +183,32 @@ class Integrator:
         motion = model.motion._replace(accel=model.motion.accel.copy())
         self.held = Held(model.held_idx, model.held_x0, model.held_v.copy(), motion)
         if motion.moving:
-            place_moving(self.x, self.v, self.held, 0.0)   # a sinusoid starts with its own velocity
+            place_moving(self.x, self.v, self.held, 0.0, 0.0)   # a sinusoid starts with its own velocity
         self.ledger = initial_ledger(model, self.x, self.v)
         self.limits = limits(model)
+        self.switches = self.switches_for(model, method)
+        self.loop = self.kernel(self.template())
+
+    def kernel(self, function):
+        """``function`` (a compiled template) specialised on this run's switches."""
+        return specialise(function, self.switches)
+
+    @classmethod
+    def compiled_loop(cls, model, method: Method):
+        """The copy of the family's loop a run of ``method`` on ``model`` calls (without building the run)."""
+        return specialise(cls.template(), cls.switches_for(model, method))
 
     # -- what a family provides --------------------------------------------------------------------------
+
+    @staticmethod
+    def template():
+        """The family's compiled loop, a template (see :func:`ropesim.model.jit.specialise`)."""
+        raise NotImplementedError
+
+    @classmethod
+    def switches_for(cls, model, method: Method) -> frozenset:
+        """The compile-time switches of a run of ``method`` on ``model``: the model's, and the family's own."""
+        return model.switches
 
     def _run(self, n: int, frames: Frames) -> tuple:
         """Run the compiled loop for ``n`` steps from ``self.step``; (steps done, frames written, status, node)."""

@@ -20,7 +20,7 @@ import math
 
 
 from ..model.forces.thrower import box_of, smooth_step, weight_at
-from ..model.terms import GUIDES, THROWER
+from ..model.terms import WITH_GUIDES, WITH_THROWER
 from ..model import jit
 
 
@@ -34,14 +34,14 @@ def _phi(lam, tau):
 
 
 @jit.kernel
-def contact_rates(x, v, i, inv_mass, flags, thrower, guides, box, three_d):
+def contact_rates(x, v, i, inv_mass, thrower, guides, box, three_d):
     """The rates [1/s] (gxx, gxy, gyy, gzz) of the velocity-linear forces the box and the circles put on node
     ``i``: the drive's and the centring's along and across the box (rotated by the launch angle), and each
     circle's pull along its radius."""
     ca, sa = thrower[10], thrower[11]
     gxx = gxy = gyy = gzz = 0.0
     outside = 1.0
-    if flags[THROWER]:
+    if WITH_THROWER:
         s = weight_at(x[0, i], x[1, i], x[2, i] if three_d else 0.0, three_d, box)
         outside = 1.0 - s
         if s > 0.0:
@@ -55,7 +55,7 @@ def contact_rates(x, v, i, inv_mass, flags, thrower, guides, box, three_d):
                 gxx += s * thrower[6] * inv_mass[i]
                 gyy += s * thrower[8]
                 gzz += s * thrower[8]
-    if flags[GUIDES] and outside > 0.0:
+    if WITH_GUIDES and outside > 0.0:
         for c in range(guides.shape[0]):
             dx = x[0, i] - guides[c, 0]
             dy = x[1, i] - guides[c, 1]
@@ -115,7 +115,7 @@ def exact_contact_kicks(x, v, acc, out, nodes, tau, gamma, free, forces):
     for i in range(x.shape[1]):
         if not free[i]:
             continue
-        gxx, gxy, gyy, gzz = contact_rates(x, v, i, forces.inv_mass, forces.flags, forces.thrower, forces.guides,
+        gxx, gxy, gyy, gzz = contact_rates(x, v, i, forces.inv_mass, forces.thrower, forces.guides,
                                            box, three_d)
         if gxx == 0.0 and gxy == 0.0 and gyy == 0.0 and gzz == 0.0:
             continue

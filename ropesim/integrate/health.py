@@ -24,7 +24,7 @@ import numpy as np
 
 from ..model import jit
 from ..model.motion import place_moving
-from ..model.terms import mechanical_energy
+from ..model.terms import WITH_MOTION, mechanical_energy
 
 OK, NON_FINITE, OVERSTRETCH, RUNAWAY_ENERGY, NEWTON_FAILED = 0, 1, 2, 3, 4
 STATUS_NAMES = {OK: "ok", NON_FINITE: "non-finite", OVERSTRETCH: "overstretched", RUNAWAY_ENERGY: "runaway energy",
@@ -142,7 +142,7 @@ def held_power(acc, mass, held):
         i = held_idx[j]
         for d in range(dim):
             p -= mass[i] * acc[d, i] * held_v[d, j]
-    if motion.moving:
+    if WITH_MOTION:
         for j in range(held_idx.shape[0]):
             i = held_idx[j]
             for d in range(dim):
@@ -151,11 +151,11 @@ def held_power(acc, mass, held):
 
 
 @jit.kernel
-def place(x, v, held, t):
+def place(x, v, held, t, t_piece):
     """Put every held node where it must be at time t: x0 + V t, or its prescribed motion (which also sets its
-    velocity in ``v``, see :mod:`ropesim.model.motion`)."""
-    if held.motion.moving:
-        place_moving(x, v, held, t)
+    velocity in ``v``; a path on its piece that holds ``t_piece``, see :mod:`ropesim.model.motion`)."""
+    if WITH_MOTION:
+        place_moving(x, v, held, t, t_piece)
     else:
         place_held(x, held.idx, held.x0, held.v, t)
 

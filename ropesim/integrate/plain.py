@@ -32,17 +32,18 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..model.terms import GRAVITY, N_FLAGS
+from ..model.terms import WITH_GRAVITY
 from .health import DRAG
 from .kick import LANES, _lanes
 from ..model import jit
 
+WITH_PLAIN_STAGE = jit.Switch("plain_stage", "the splitting loop's stage for a 2-D rope of springs and gravity")
 BULK_FIXED = 1        # bulk = [1 / m, then per kick stage: decay, gain, reach]
 BULK_PER_STAGE = 3
 
-Plain = namedtuple("Plain", ["active", "bulk", "exceptions", "exception_factors", "saved_x", "saved_v", "saved_lost",
+Plain = namedtuple("Plain", ["bulk", "exceptions", "exception_factors", "saved_x", "saved_v", "saved_lost",
                              "free_mass", "kinetic0", "has_drag", "lengths", "terms"])
-"""The plain stage's data: ``active`` (use it), the bulk factors, the exceptions' indices (E,), factors
+"""The plain stage's data: the bulk factors, the exceptions' indices (E,), factors
 (stages, 3, E) and saved pre-kick x, v (2, E) and work (E,), the free nodes' masses (N,) (0 at held ones),
 their kinetic energy at t = 0 [J], whether any free node has drag, and the check's scratch rows (N,)."""
 
@@ -50,10 +51,8 @@ their kinetic energy at t = 0 [J], whether any free node has drag, and the check
 def applies(model, scheme) -> bool:
     """True when ``model`` stepped by the splitting ``scheme`` can take the plain stage: a 2-D rope whose only
     force terms are its springs (that push as well as pull) and gravity."""
-    flags = model.params.flags
-    others = [f for f in range(N_FLAGS) if f != GRAVITY]
-    return (model.dim == 2 and model.nodes >= 2 and not any(flags[f] for f in others)
-            and model.scene.rope.compression and not model.motion.moving)
+    return (model.dim == 2 and model.nodes >= 2 and model.switches <= {WITH_GRAVITY.name}
+            and model.scene.rope.compression)
 
 
 def plain_bundle(model, decay: np.ndarray, gain: np.ndarray, travel: np.ndarray) -> Plain:
@@ -83,13 +82,13 @@ def plain_bundle(model, decay: np.ndarray, gain: np.ndarray, travel: np.ndarray)
     free_mass = np.where(free, mass, 0.0)
     terms = np.zeros(model.nodes)
     kinetic0 = -settle(np.zeros(model.nodes), model.v0, free_mass, 0.0, terms)   # K(0) [J]
-    return Plain(True, bulk, e, factors, np.zeros((2, e.size)), np.zeros((2, e.size)), np.zeros(e.size), free_mass,
+    return Plain(bulk, e, factors, np.zeros((2, e.size)), np.zeros((2, e.size)), np.zeros(e.size), free_mass,
                  kinetic0, bool(np.any(drag[free] > 0.0)), np.zeros(model.nodes), terms)
 
 
 def inactive_bundle(stages: int) -> Plain:
-    """A Plain of the same types that the general stage carries unused (one compiled signature for both)."""
-    return Plain(False, np.zeros(BULK_FIXED + BULK_PER_STAGE * stages), np.zeros(0, dtype=np.int64),
+    """A Plain of the same types that the general stage carries unused (one argument layout for both)."""
+    return Plain(np.zeros(BULK_FIXED + BULK_PER_STAGE * stages), np.zeros(0, dtype=np.int64),
                  np.zeros((stages, 3, 0)), np.zeros((2, 0)), np.zeros((2, 0)), np.zeros(0), np.zeros(0), 0.0, False,
                  np.zeros(0), np.zeros(0))
 

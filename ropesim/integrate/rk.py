@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.terms import ADDED_MASS, accelerations, added_mass, any_applied, applied_accelerations
+from ..model.terms import WITH_ADDED_MASS, WITH_APPLIED, accelerations, added_mass, applied_accelerations
 from .base import Integrator, Method
 from .health import BOX, DRAG, FLUID, HELD, INTERNAL, OK, SEABED, due, end_step, held_power, place, power
 from ..model import jit
@@ -88,14 +88,18 @@ class RungeKuttaFamily(Integrator):
                                  np.zeros((stages,) + shape), np.zeros(shape), np.zeros(shape))
         self.gamma = np.where(model.held, 0.0, model.drag / model.mass)
 
+    @staticmethod
+    def template():
+        return advance_rk
+
     @property
     def force_evaluations(self) -> int:
         return self.step * self.method.evaluations
 
     def _run(self, n, frames):
         m = self.model
-        return advance_rk((self.x, self.v, self.ledger), self.tables, self.scratch, self.held, m.mass, self.gamma,
-                          m.params, self.limits, self.schedule(n), frames)
+        return self.loop((self.x, self.v, self.ledger), self.tables, self.scratch, self.held, m.mass, self.gamma,
+                         m.params, self.limits, self.schedule(n), frames)
 
 
 @jit.kernel
@@ -144,14 +148,13 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
     h = schedule.h
     dim, n = x.shape
     stages = b.shape[0]
-    has_box = any_applied(params.flags)
     frame = np.int64(0)   # not the literal 0: Numba would compile the frame saving twice (for 0, then int64)
     for s in range(schedule.n_steps):
         step = schedule.step0 + s
         t = step * h
         for st in range(stages):
             stage_state(x, v, kx, kv, a, st, h, xs, vs)
-            place(xs, vs, held, t + c[st] * h)
+            place(xs, vs, held, t + c[st] * h, t + 0.5 * h)   # a path: this step's piece
             for j in range(held_idx.shape[0]):
                 for d in range(dim):
                     vs[d, held_idx[j]] = held_v[d, j]
@@ -162,7 +165,7 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
                     kx[st, d, i] = vs[d, i]
                     kv[st, d, i] = acc[d, i] - gamma[i] * vs[d, i]
                     lost += gamma[i] * mass[i] * vs[d, i] * vs[d, i]
-            if params.flags[ADDED_MASS]:
+            if WITH_ADDED_MASS:
                 fluid += added_mass(xs, vs, kv[st], params)
             for j in range(held_idx.shape[0]):
                 for d in range(dim):
@@ -173,11 +176,11 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
             ledger[FLUID] += wh * fluid
             ledger[INTERNAL] += wh * internal
             ledger[SEABED] += wh * seabed
-            if has_box:
+            if WITH_APPLIED:
                 applied_accelerations(xs, vs, acc_box, params)
                 ledger[BOX] += wh * power(acc_box, vs, mass)
         combine(x, v, kx, kv, b, h)
-        place(x, v, held, (step + 1) * h)
+        place(x, v, held, (step + 1) * h, (step + 1) * h)
         done = step + 1
         if not due(done, schedule):
             continue  # nothing due: skip the call, whose array arguments cost more than a small rope's step

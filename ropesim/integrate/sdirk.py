@@ -31,8 +31,8 @@ import numpy as np
 
 from ..model.jacobian import Jacobian, band_width
 from ..model.forces.added_mass import added_mass_times
-from ..model.terms import (ADDED_MASS, accelerations, added_mass, any_applied, applied_accelerations, coupling_reach,
-                           newton_matrix)
+from ..model.terms import (WITH_ADDED_MASS, WITH_APPLIED, accelerations, added_mass, applied_accelerations,
+                           coupling_reach, newton_matrix)
 from ..model.banded import factor, solve, woodbury
 from .base import Integrator, Method
 from .health import BOX, DRAG, FLUID, HELD, INTERNAL, NEWTON_FAILED, OK, SEABED, due, end_step, held_power, place, power
@@ -116,14 +116,18 @@ class SdirkFamily(Integrator):
         self.nodes = Nodes(np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag))
         self.stats = np.zeros(1, dtype=np.int64)
 
+    @staticmethod
+    def template():
+        return advance_sdirk
+
     @property
     def force_evaluations(self) -> int:
         """Newton iterations so far."""
         return int(self.stats[0])
 
     def _run(self, n, frames):
-        return advance_sdirk((self.x, self.v, self.ledger, self.stats), self.stage, self.newton, self.held,
-                             self.nodes, self.model.params, self.limits, self.schedule(n), frames)
+        return self.loop((self.x, self.v, self.ledger, self.stats), self.stage, self.newton, self.held, self.nodes,
+                         self.model.params, self.limits, self.schedule(n), frames)
 
 
 @jit.kernel
@@ -135,7 +139,6 @@ def stage_residual(stage, rhs, beta, t_stage, held, nodes, params):
     held_idx, held_v = held.idx, held.v
     free, mass, drag = nodes
     dim, n = X.shape
-    inertial = params.flags[ADDED_MASS] != 0
     closed = params.spring[2] != 0.0
     for d in range(dim):
         for i in range(n):
@@ -153,7 +156,7 @@ def stage_residual(stage, rhs, beta, t_stage, held, nodes, params):
                            - beta * beta * m * acc[d, i])
             else:
                 rhs[u] = 0.0
-        if inertial and free[i]:   # + A_i (X - xh - beta vh)
+        if WITH_ADDED_MASS and free[i]:   # + A_i (X - xh - beta vh)
             w0 = X[0, i] - xh[0, i] - beta * vh[0, i]
             w1 = X[1, i] - xh[1, i] - beta * vh[1, i]
             w2 = X[2, i] - xh[2, i] - beta * vh[2, i] if dim == 3 else 0.0
@@ -194,7 +197,7 @@ def take_back_half(X, step):
 
 
 @jit.kernel
-def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
+def solve_stage(stage, newton, beta, t_stage, t_piece, held, nodes, params):
     """Newton solve of one stage: X = xh + beta V, V = vh + beta (a(X, V) - gamma V). Returns
     (iterations, node, fluid power [W], internal-damping power [W]): iterations < 0 when it failed, naming the
     node that moved most in the last one. With added mass the stage's equation is M (V - vh) = beta (F - b V),
@@ -207,7 +210,7 @@ def solve_stage(stage, newton, beta, t_stage, held, nodes, params):
     for d in range(dim):
         for i in range(n):
             X[d, i] = xh[d, i] + beta * vh[d, i]
-    place(X, V, held, t_stage)
+    place(X, V, held, t_stage, t_piece)   # a path: the step's piece (t_piece its middle)
     worst_node = -1
     last = np.inf            # the residual's norm before the last update
     stride = 0.0             # the last update's largest component [m]
@@ -249,7 +252,6 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
     free, mass, drag = nodes
     h = schedule.h
     dim, n = x.shape
-    has_box = any_applied(params.flags)
     beta = GAMMA * h
     frame = np.int64(0)   # not the literal 0: Numba would compile the frame saving twice (for 0, then int64)
     for s in range(schedule.n_steps):
@@ -261,7 +263,8 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
                 vh[d, i] = v[d, i]
         for k in range(2):
             t_stage = t + (GAMMA if k == 0 else 1.0) * h
-            its, node, fluid, internal, seabed = solve_stage(stage, newton, beta, t_stage, held, nodes, params)
+            its, node, fluid, internal, seabed = solve_stage(stage, newton, beta, t_stage, t + 0.5 * h, held, nodes,
+                                                             params)
             if its < 0:
                 return s, frame, NEWTON_FAILED, node
             stats[0] += its
@@ -272,7 +275,7 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
                     lost += drag[i] * V[d, i] * V[d, i]
             ledger[DRAG] += weight * lost
             ledger[HELD] += weight * held_power(acc, mass, held)
-            if params.flags[ADDED_MASS]:   # the fluid's inertial force, m a - F, at the stage
+            if WITH_ADDED_MASS:   # the fluid's inertial force, m a - F, at the stage
                 for d in range(dim):
                     for i in range(n):
                         tmp[d, i] = acc[d, i] - drag[i] * V[d, i] / mass[i]
@@ -280,7 +283,7 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
             ledger[FLUID] += weight * fluid
             ledger[INTERNAL] += weight * internal
             ledger[SEABED] += weight * seabed
-            if has_box:
+            if WITH_APPLIED:
                 applied_accelerations(X, V, acc_box, params)
                 ledger[BOX] += weight * power(acc_box, V, mass)
             if k == 0:
@@ -293,7 +296,7 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
             for i in range(n):
                 x[d, i] = X[d, i]
                 v[d, i] = V[d, i]
-        place(x, v, held, (step + 1) * h)
+        place(x, v, held, (step + 1) * h, (step + 1) * h)
         done = step + 1
         if not due(done, schedule):
             continue  # nothing due: skip the call, whose array arguments cost more than a small rope's step

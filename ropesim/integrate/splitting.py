@@ -30,13 +30,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model import jit
-from ..model.terms import GRAVITY, accelerations, has_applied, applied_accelerations, mechanical_energy, position_accelerations
+from ..model.terms import (WITH_APPLIED, WITH_GRAVITY, WITH_MOTION, WITH_VELOCITY_TERMS, accelerations,
+                           applied_accelerations, mechanical_energy, position_accelerations)
 from .base import Integrator, Method
 from .contact import exact_contact_kicks
 from .health import (BOX, DRAG, E0, FLUID, HELD, INTERNAL, OK, SCALE, SEABED, balance_status, flows, save_frame,
                      verdict)
 from .kick import box_work, kick_drift
-from .plain import BULK_FIXED, BULK_PER_STAGE, applies, chain_energy, inactive_bundle, plain_bundle, settle_drag
+from .plain import (BULK_FIXED, BULK_PER_STAGE, WITH_PLAIN_STAGE, applies, chain_energy, inactive_bundle, plain_bundle,
+                    settle_drag)
 from ..model.motion import place_moving
 from .velocity_kick import velocity_kick, velocity_scratch
 
@@ -161,12 +163,11 @@ per-node work (N,)."""
 Kicks = namedtuple("Kicks", ["drift", "kick", "decay", "gain", "travel", "reuse_force"])
 """The scheme's drift and kick coefficients and the exact drag kick's factors (stages, N) per node."""
 
-General = namedtuple("General", ["acc_box", "has_box", "exact", "free", "gamma", "v_contact", "contact_nodes", "buf",
-                                 "velocity", "vscratch"])
-"""The general stage's scratch: the applied terms' accelerations (D, N) and whether any is on; the exact
-contact kicks (on or off, free nodes, drag rates b/m, their velocities (D, N) and node list); kick scratch;
-whether forces beyond the thrower's and guides' depend on velocity (the kick is then
-:func:`ropesim.integrate.velocity_kick.velocity_kick`) and its scratch."""
+General = namedtuple("General", ["acc_box", "exact", "free", "gamma", "v_contact", "contact_nodes", "buf", "vscratch"])
+"""The general stage's scratch: the applied terms' accelerations (D, N); the exact contact kicks (on or off,
+free nodes, drag rates b/m, their velocities (D, N) and node list); kick scratch; the scratch of
+:func:`ropesim.integrate.velocity_kick.velocity_kick` (the kick when forces beyond the thrower's and guides'
+depend on velocity)."""
 
 
 class Splitting(Integrator):
@@ -181,28 +182,39 @@ class Splitting(Integrator):
         self.reuse_force = method.reuses_last_force and not model.velocity_dependent
         decay, gain, travel = kick_factors(method, grid.dt, model.drag, model.mass, model.held)
         self.kicks = Kicks(np.array(method.drift), np.array(method.kick), decay, gain, travel, self.reuse_force)
-        plain = specialise and applies(model, method)
+        if not specialise:
+            self.switches = self.switches - {WITH_PLAIN_STAGE.name}
+            self.loop = self.kernel(advance_splitting)
+        plain = self.on_plain_stage
         self.plain = plain_bundle(model, decay, gain, travel) if plain else inactive_bundle(stages)
         self.acc = np.zeros_like(self.x)
         self.have_acc = np.zeros(1, dtype=np.bool_)
         self.spring_forces = np.zeros((2, model.nodes + 1) if plain else (2, 1))
         self.lost = np.zeros(model.nodes if plain else 0)
-        has_box = has_applied(model.params)
-        self.general = General(np.zeros_like(self.x), has_box, model.smooth_contacts and has_box,
+        self.general = General(np.zeros_like(self.x), model.smooth_contacts and model.applied,
                                np.ascontiguousarray(~model.held), np.where(model.held, 0.0, model.drag / model.mass),
                                np.zeros_like(self.x), np.zeros(model.nodes, dtype=np.int64), np.empty(model.nodes),
-                               model.velocity_terms, velocity_scratch(*self.x.shape))
+                               velocity_scratch(*self.x.shape))
         self.bundle = SplittingState(self.x, self.v, self.acc, self.have_acc, self.ledger, self.spring_forces,
                                      self.lost)
 
+    @staticmethod
+    def template():
+        return advance_splitting
+
+    @classmethod
+    def switches_for(cls, model, method) -> frozenset:
+        """The model's switches, and the plain stage where it applies."""
+        return model.switches | ({WITH_PLAIN_STAGE.name} if applies(model, method) else set())
+
     @property
     def on_plain_stage(self) -> bool:
-        return bool(self.plain.active)
+        return WITH_PLAIN_STAGE.name in self.switches
 
     def set_exact_contacts(self, on: bool) -> None:
         """Kick nodes touching the box or a circle exactly (``on``) or plainly, whatever the edges (for the
         accuracy study; by default the kick is exact when the edges are smoothed)."""
-        self.general = self.general._replace(exact=bool(on) and self.general.has_box)
+        self.general = self.general._replace(exact=bool(on) and self.model.applied)
 
     @property
     def force_evaluations(self) -> int:
@@ -211,8 +223,8 @@ class Splitting(Integrator):
 
     def _run(self, n, frames):
         m = self.model
-        return advance_splitting(self.bundle, self.kicks, self.plain, self.general, self.held, m.mass, m.params,
-                                 self.limits, self.schedule(n), frames)
+        return self.loop(self.bundle, self.kicks, self.plain, self.general, self.held, m.mass, m.params, self.limits,
+                         self.schedule(n), frames)
 
 
 @jit.kernel
@@ -220,7 +232,7 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
     """Advance ``schedule.n_steps`` splitting steps in place, from global step ``schedule.step0``.
 
     The contract of :mod:`ropesim.integrate.base`; returns (steps done, frames written, status, node). Each
-    kick stage is the plain stage (``plain.active``: a 2-D rope with its springs and gravity alone; see
+    kick stage is the plain stage (switch ``WITH_PLAIN_STAGE``: a 2-D rope with its springs and gravity alone; see
     :mod:`ropesim.integrate.plain`) or the general one; both are written out here rather than called, because
     a helper taking arrays costs an atomic reference-count update per array and call, more than a small rope's
     whole step on the plain stage. That, and the plain stage's two copies of its kick (a flag tested inside
@@ -229,19 +241,17 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
     x, v, acc, have_acc, ledger, f, lost = state
     drift, kick, decay_k, gain_k, travel_k, reuse_force = kicks
     held_idx, held_x0, held_v, motion = held
-    moving = motion.moving
     step0, n_steps, total_steps, h, save_every, check_every = schedule
     dim, n = x.shape
     stages = kick.shape[0]
     n_held = held_idx.shape[0]
     inv_mass = params.inv_mass
-    g = params.gravity[0] if params.flags[GRAVITY] else 0.0
+    g = params.gravity[0] if WITH_GRAVITY else 0.0
     k_spring, rest, closed = params.spring[0], params.spring[1], params.spring[2] != 0.0
-    is_plain = plain.active
     px, py, vx, vy, fx, fy = x[0], x[1], v[0], v[1], f[0], f[1]   # the plain stage's rows
     inv_m = plain.bulk[0]
     n_exc = plain.exceptions.shape[0]
-    if is_plain and not closed:
+    if WITH_PLAIN_STAGE and not closed:
         fx[0] = fx[n] = fy[0] = fy[n] = 0.0
     held_work = ledger[HELD]   # kept in a register, stored whenever the ledger is read
     frame = np.int64(0)   # not the literal 0: Numba would compile the frame saving twice (for 0, then int64)
@@ -250,17 +260,18 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
     for s in range(n_steps):
         step = step0 + s
         t = step * h
-        if moving:   # the held nodes' velocities and accelerations at t, for the supports' power
-            place_moving(x, v, held, t)
+        middle = t + 0.5 * h   # a path: every stage of this step on its piece (see ropesim/model/motion.py)
+        if WITH_MOTION:   # the held nodes' velocities and accelerations at t, for the supports' power
+            place_moving(x, v, held, t, middle)
         if drift[0] != 0.0:
             ch = drift[0] * h
             for d in range(dim):
                 for i in range(n):
                     x[d, i] += ch * v[d, i]
             t += ch
-            if moving:
-                place_moving(x, v, held, t)
-            for j in range(n_held if not moving else 0):   # health.place_held, written out: its call cost 2.5 %
+            if WITH_MOTION:
+                place_moving(x, v, held, t, middle)
+            for j in range(n_held if not WITH_MOTION else 0):   # health.place_held, written out: its call cost 2.5 %
                 i = held_idx[j]
                 for d in range(dim):
                     x[d, i] = held_x0[d, j] + held_v[d, j] * t
@@ -268,7 +279,7 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
             ch = drift[st + 1] * h
             fresh = not (st == 0 and reuse_force and have_acc[0])
             p = 0.0   # the supports' power on the rope: a held node does not accelerate, so its support pushes -m a
-            if is_plain:
+            if WITH_PLAIN_STAGE:
                 # ---- the plain stage: spring forces into f, then the bulk kick and drift from them
                 if fresh:
                     for i in range(n - 1):
@@ -347,7 +358,7 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
                     p -= mass[i] * ay * held_v[1, j]
                     vx[i] = held_v[0, j]
                     vy[i] = held_v[1, j]
-            elif general.velocity:
+            elif WITH_VELOCITY_TERMS:
                 # ---- velocity-dependent forces: RK4 sub-stages at frozen positions, the ledger by the same rule
                 position_accelerations(x, acc, params)
                 loss, supports, box, fluid, internal, seabed = velocity_kick(x, v, acc, kick[st] * h, t, params,
@@ -368,11 +379,11 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
                 if fresh:
                     accelerations(x, v, acc, params, t)
                 box = 0.0
-                if general.has_box:
+                if WITH_APPLIED:
                     applied_accelerations(x, v, general.acc_box, params)
                     box = box_work(v, acc, general.acc_box, gain_k, travel_k, st, mass)   # from velocities before
                 touching = 0
-                if general.exact:
+                if WITH_APPLIED and general.exact:
                     touching = exact_contact_kicks(x, v, acc, general.v_contact, general.contact_nodes,
                                                    kick[st] * h, general.gamma, general.free, params)
                 # the kick, the loss it books and the next drift, fused; a contact kick replaces some
@@ -391,9 +402,9 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
                     i = held_idx[j]
                     for d in range(dim):
                         p -= mass[i] * acc[d, i] * held_v[d, j]
-                        if moving:
+                        if WITH_MOTION:
                             p += mass[i] * motion.accel[d, j] * held_v[d, j]
-                if general.has_box:
+                if WITH_APPLIED:
                     for j in range(n_held):
                         i = held_idx[j]
                         for d in range(dim):
@@ -402,9 +413,9 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
             held_work += kick[st] * h * p
             if ch != 0.0:
                 t += ch
-                if moving:
-                    place_moving(x, v, held, t)
-                for j in range(n_held if not moving else 0):
+                if WITH_MOTION:
+                    place_moving(x, v, held, t, middle)
+                for j in range(n_held if not WITH_MOTION else 0):
                     i = held_idx[j]
                     for d in range(dim):
                         x[d, i] = held_x0[d, j] + held_v[d, j] * t
@@ -418,7 +429,7 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
         if done == next_save:
             next_save += save_every
         ledger[HELD] = held_work
-        if is_plain:
+        if WITH_PLAIN_STAGE:
             settle_drag(ledger, lost, v, plain.free_mass, plain.kinetic0, plain.has_drag, held_idx, plain.terms)
             energy, stretch, worst = chain_energy(x, v, mass, k_spring, rest, closed, g, plain.lengths, plain.terms)
         else:
@@ -434,6 +445,6 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
             save_frame(frame, done * h, x, v, ledger, frames.t, frames.x, frames.v, frames.ledger)
             frame += 1
     ledger[HELD] = held_work
-    if is_plain:
+    if WITH_PLAIN_STAGE:
         settle_drag(ledger, lost, v, plain.free_mass, plain.kinetic0, plain.has_drag, held_idx, plain.terms)
     return n_steps, frame, OK, -1

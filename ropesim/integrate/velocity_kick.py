@@ -20,7 +20,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..model.terms import added_mass, any_applied, applied_accelerations, velocity_accelerations
+from ..model.terms import WITH_APPLIED, added_mass, applied_accelerations, velocity_accelerations
 from ..model import jit
 
 RK4_A = (0.0, 0.5, 0.5, 1.0)          # each sub-stage's offset along the kick, as a fraction of tau
@@ -47,7 +47,6 @@ def velocity_kick(x, v, acc_x, tau, t, params, mass, gamma, held, scratch):
     dim, n = x.shape
     slopes, y, a, a_box = scratch
     held_idx, held_v, motion = held.idx, held.v, held.motion
-    has_box = any_applied(params.flags)
     drag = supports = box = fluid = internal = seabed = 0.0
     for s in range(4):
         c = RK4_A[s] * tau
@@ -70,7 +69,7 @@ def velocity_kick(x, v, acc_x, tau, t, params, mass, gamma, held, scratch):
                 p_drag += gamma[i] * mass[i] * y[d, i] * y[d, i]
         p_fluid += added_mass(x, y, a, params)
         p_box = 0.0
-        if has_box:
+        if WITH_APPLIED:
             applied_accelerations(x, y, a_box, params)
             for d in range(dim):
                 for i in range(n):

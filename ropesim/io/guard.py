@@ -31,8 +31,11 @@ PVD_MARK = "<!-- written by ropesim export -->"
 
 # A run folder's own entries (see ropesim.io.runfolder) and what commands write into it by default.
 RUN_FILES = frozenset({*RUN_MARKERS, STATE, LOCK})
-DEFAULT_OUTPUTS = frozenset({"plots.png", "frames.png", "animation.gif", "animation.mp4", "trajectory.csv", "vtk"})
+DEFAULT_OUTPUTS = frozenset({"plots.png", "frames.png", "animation.gif", "animation.mp4", "trajectory.csv", "vtk",
+                             "trajectory_tension_history.csv", "trajectory_tension_range.csv"})
 CSV_HEADERS = ("t [s],node,",                         # ropesim export --to csv
+               "t [s],tension segment 0 [",           # ... its time history of the forces
+               "segment,s [m],min tension [",         # ... its tension range along the rope
                "method,dt,steps,status,",             # ropesim accuracy: accuracy.csv
                "stiffness,method,dt,dt_over_ref",     # ropesim stability: stability.csv
                "stiffness,method,ref_dt,")            # ropesim stability: bounds.csv

@@ -1,8 +1,9 @@
 """Turn a validated :class:`Scene` into the arrays the compiled kernel works on.
 
 Nothing here steps time: it lays out the initial state (shape (D, N), structure of arrays), the per-node
-masses and drag coefficients, the held (pinned or driven) nodes, and the force terms' parameters and flags
-(:func:`ropesim.model.terms.model_params`).
+masses and drag coefficients, the held (pinned or driven) nodes, the force terms' parameters
+(:func:`ropesim.model.terms.model_params`) and the compile-time switches that choose what compiles
+(:func:`ropesim.model.terms.switches`, plus prescribed motion).
 
 Node masses: the rope's ``mass`` per node; in physical units an open line's two end nodes carry half of it
 (half a segment, as lumped-mass cable codes do); then ``[[overrides]]`` set a node's mass, and a body adds its
@@ -19,7 +20,8 @@ import numpy as np
 from ..scene import schema as S
 from ..scene.shapes import initial_positions
 from .motion import Motion, motion_of
-from .terms import Layout, ModelParams, has_applied, model_params, velocity_terms_on
+from . import jit
+from .terms import WITH_APPLIED, WITH_MOTION, WITH_VELOCITY_TERMS, Layout, ModelParams, model_params, switches
 
 
 @dataclass
@@ -35,8 +37,9 @@ class Model:
     held_idx: np.ndarray      # (H,) int64 indices of held nodes
     held_x0: np.ndarray       # (D, H) their positions at t = 0 [m]
     held_v: np.ndarray        # (D, H) their constant velocities [m/s]
-    params: ModelParams       # the force terms' parameters and flags, for the compiled code
+    params: ModelParams       # the force terms' parameters, for the compiled code
     motion: Motion            # the held nodes' prescribed motion beyond x0 + V t (see model/motion.py)
+    switches: jit.Switches    # the compile-time switches that are on: the scene's terms, prescribed motion
 
     @property
     def dim(self) -> int:
@@ -46,16 +49,26 @@ class Model:
     def nodes(self) -> int:
         return self.x0.shape[1]
 
+    def kernel(self, function):
+        """``function`` (a compiled template) specialised on this model's switches (see
+        :func:`ropesim.model.jit.specialise`): what Python calls of the term list."""
+        return jit.specialise(function, self.switches)
+
     @property
     def velocity_dependent(self) -> bool:
         """True when a force other than the linear [drag] depends on velocity (the thrower, the guide circles,
         fluid drag, axial damping, added mass)."""
-        return has_applied(self.params) or self.velocity_terms
+        return self.applied or self.velocity_terms
 
     @property
     def velocity_terms(self) -> bool:
         """True when a term beyond the thrower's and guides' depends on velocity (see Term.velocity)."""
-        return velocity_terms_on(self.params)
+        return WITH_VELOCITY_TERMS.name in self.switches
+
+    @property
+    def applied(self) -> bool:
+        """True when a term booked as box work is on (the thrower, the guide circles)."""
+        return WITH_APPLIED.name in self.switches
 
     @property
     def has_drag(self) -> bool:
@@ -106,9 +119,11 @@ def build(scene: S.Scene, solve: bool = True) -> Model:
     v0[:, held_idx] = held_v[:, held_idx]
 
     layout = Layout(mass, held, node_lengths(scene))
+    motion = motion_of(scene, held_idx)
     model = Model(scene=scene, x0=x0, v0=v0, mass=mass, drag=drag, held=held, held_idx=held_idx,
                   held_x0=np.ascontiguousarray(x0[:, held_idx]), held_v=np.ascontiguousarray(held_v[:, held_idx]),
-                  params=model_params(scene, layout), motion=motion_of(scene, held_idx))
+                  params=model_params(scene, layout), motion=motion,
+                  switches=switches(scene) | ({WITH_MOTION.name} if motion.moving else set()))
     if solve and isinstance(scene.initial, S.EquilibriumStart):
         from .statics import solve_equilibrium
 

@@ -1,4 +1,4 @@
-"""How ropesim compiles its kernels: one decorator for every function the integration loops call.
+"""How ropesim compiles its kernels: one decorator for every compiled function, and compile-time switches.
 
 ``kernel`` (used as ``@jit.kernel``, the module named at every use so that a reader, and
 ``../shared/tools/shape.py``, sees a compiled function) is Numba's ``njit`` in nopython mode with three
@@ -17,11 +17,39 @@ settings fixed for the whole code base:
   Numba refuses to compile a kernel that would allocate, so this cannot go wrong silently: such a function
   uses plain ``njit``. ``tests/test_performance_invariants.py`` checks that the compiled term list counts no
   references, so a Numba release that changed the option would be noticed.
+
+**Compile-time switches.** A scene compiles only the parts it uses. A kernel tests a part with a
+:class:`Switch`, a module-level name it reads as a plain condition (``if WITH_SEABED:``, also inside ``and``,
+``or`` and ``x if WITH_GRAVITY else 0.0``). Such a kernel is a template: :func:`specialise` makes a copy of
+it for given switch values, with each switch replaced by True or False in the copy's globals, and Numba's
+dead-branch pruning removes the false branches *before* typing, so the kernels behind them are never typed
+nor compiled. Kernels that call a switched kernel are copied too, down the call graph, so a family's loop
+specialised for a scene calls that scene's term list; kernels that read no switch, directly or through
+their callees (the force terms themselves, the banded solver), are shared by every copy.
+
+Each copy is an ordinary cached Numba function: its qualified name carries the values of the switches it
+reads (``accelerations__s1a`` for one set), so Numba's on-disk cache keeps one entry per set, found again by
+a new process, and stamped by the source file as every cached function is. Two scenes that agree on the
+switches a kernel reads share its copy (and its cache entry): the energy check of a scene with fluid drag is
+the one of the same scene without it. A template itself cannot run: a switch's module-level value is a
+:class:`Switch` object, which Numba refuses to type, so calling an unspecialised template fails at once
+instead of compiling every part.
+
+Measured on the 2-core machine (numba 0.68): this is one of the two designs that reload from the cache in a
+new process (generated source files are the other, with a code generator to maintain); a closure composed at
+run time, ``literal_unroll`` over a tuple of kernels and a kernel passed as an argument all recompile in
+every process; runtime flags (the design before this) compile every term for every scene.
 """
 
 from __future__ import annotations
 
+import dis
+import re
+import types
+from dataclasses import dataclass
+
 from numba import njit
+from numba.core.registry import CPUDispatcher
 
 OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False}
 
@@ -30,6 +58,94 @@ def kernel(function=None, *, inline: str = "never"):
     """Compile ``function`` as a ropesim kernel (see the module doc); ``@kernel`` or ``@kernel(inline="always")``
     (Numba's inlining at its own IR level, for small helpers called in the innermost loops)."""
     def decorate(fn):
-        return njit(inline=inline, **OPTIONS)(fn)
+        dispatcher = njit(inline=inline, **OPTIONS)(fn)
+        dispatcher.ropesim_inline = inline   # for specialise's copies (Numba keeps no record of the jit options)
+        return dispatcher
 
     return decorate(function) if function is not None else decorate
+
+
+@dataclass(frozen=True)
+class Switch:
+    """A compile-time switch: a part of the model (a force term, the plain stage, prescribed motion) that a
+    kernel compiles only when a scene has it. Bound to a module-level name that kernels test
+    (``if WITH_SEABED:``); :func:`specialise` replaces it with True or False. ``name`` is its key in a set of
+    switches (:data:`Switches`)."""
+
+    name: str
+    doc: str = ""
+
+
+Switches = frozenset
+"""The names of the switches that are on, for :func:`specialise` (every other switch is off)."""
+
+
+_reads: dict = {}
+_copies: dict = {}
+COPY_SUFFIX = re.compile(r"__s[0-9a-f]+$")
+
+
+def _globals_read(function) -> set[str]:
+    """The global names ``function``'s code loads (nested code objects included; not attribute names, which
+    share ``co_names`` with them)."""
+    names, stack = set(), [function.__code__]
+    while stack:
+        code = stack.pop()
+        names.update(op.argval for op in dis.get_instructions(code) if op.opname in ("LOAD_GLOBAL", "LOAD_NAME"))
+        stack.extend(c for c in code.co_consts if isinstance(c, types.CodeType))
+    return names
+
+
+def switches_read(dispatcher) -> frozenset:
+    """The names of the switches ``dispatcher`` reads, itself or through the kernels it calls."""
+    if dispatcher in _reads:
+        return _reads[dispatcher]
+    _reads[dispatcher] = frozenset()   # a recursive kernel reads what its other callees read
+    function, found = dispatcher.py_func, set()
+    for name in _globals_read(function):
+        value = function.__globals__.get(name)
+        if isinstance(value, Switch):
+            found.add(value.name)
+        elif isinstance(value, CPUDispatcher):
+            found |= switches_read(value)
+    _reads[dispatcher] = frozenset(found)
+    return _reads[dispatcher]
+
+
+def specialise(dispatcher, on: Switches):
+    """``dispatcher``'s copy for the switches named in ``on`` (every other switch off); ``dispatcher`` itself
+    when it reads no switch. Copies are made once per process and per values of the switches they read."""
+    reads = switches_read(dispatcher)
+    if not reads:
+        return dispatcher
+    values = tuple(name in on for name in sorted(reads))
+    key = (dispatcher, values)
+    copy = _copies.get(key)
+    if copy is None:
+        function = dispatcher.py_func
+        namespace = dict(function.__globals__)
+        for name in _globals_read(function):
+            value = namespace.get(name)
+            if isinstance(value, Switch):
+                namespace[name] = value.name in on
+            elif isinstance(value, CPUDispatcher) and switches_read(value):
+                namespace[name] = specialise(value, on)
+        clone = types.FunctionType(function.__code__, namespace, function.__name__, function.__defaults__,
+                                   function.__closure__)
+        bits = sum(1 << i for i, value in enumerate(values) if value)
+        clone.__qualname__ = f"{function.__qualname__}__s{bits:x}"   # its own entry in Numba's cache (COPY_SUFFIX)
+        clone.__module__, clone.__doc__ = function.__module__, function.__doc__
+        copy = kernel(clone, inline=getattr(dispatcher, "ropesim_inline", "never"))
+        copy.ropesim_template = dispatcher
+        _copies[key] = copy
+    return copy
+
+
+def template_of(dispatcher):
+    """The template a :func:`specialise` copy was made from (``dispatcher`` itself when it is none)."""
+    return getattr(dispatcher, "ropesim_template", dispatcher)
+
+
+def template_name(qualname: str) -> str:
+    """A compiled function's name without the switch values :func:`specialise` appends to a copy's."""
+    return COPY_SUFFIX.sub("", qualname)

@@ -8,6 +8,16 @@ which the loops read for the supports' power on the rope (a support pushes m a -
 acceleration). The path is piecewise linear: its velocity jumps at its rows, and its acceleration there (an
 impulse) is left out of the supports' power, a ledger error of the order of the jump times the step.
 
+Which piece of the path a time takes: the one that holds ``t_piece``, evaluated at t (and extended past its
+rows if t lies beyond them). The loops pass the middle of the step being taken for every stage of it, so a
+step between two rows moves the node on one straight piece from its first stage to its last: a stage that
+lands on a row (the last stage of a step ending there, a Yoshida drift past it) keeps the step's own
+velocity, and every method keeps its order, as MoorDyn moves a coupled point on one piece for the whole
+coupling step. (A stage deciding by its own time took the next piece's velocity at a row, and every method
+fell to first order.) A state at a step's end is placed with ``t_piece = t``: on the path, the row's next
+piece. A step that straddles a row (the rows not a whole number of steps apart) cannot keep the order: keep
+the path's row spacing a multiple of dt.
+
 Parameters (per held node j, axis d): ``base`` (D, H) the constant velocity V; ``amp``, ``omega``, ``phase``
 (D, H) the sinusoid A sin(omega t + phase) - A sin(phase); ``ramp`` (H,) the ramp time; ``path_t`` (K,) and
 ``path_d`` (D, K) every path's rows, concatenated, and ``span`` (H, 2) the rows of node j's path (empty if
@@ -69,8 +79,9 @@ def ramp_factor(t, ramp):
 
 
 @jit.kernel
-def offset(m, j, d, t):
-    """(position, velocity, acceleration) of held node j's motion along axis d at time t, beyond x0 + V t."""
+def offset(m, j, d, t, t_piece):
+    """(position, velocity, acceleration) of held node j's motion along axis d at time t, beyond x0 + V t; a
+    path on its piece that holds time ``t_piece`` (see the module doc)."""
     s = ds = dds = 0.0
     a = m.amp[d, j]
     if a != 0.0:
@@ -81,12 +92,12 @@ def offset(m, j, d, t):
         dds = -a * w * w * math.sin(arg)
     lo, hi = m.span[j, 0], m.span[j, 1]
     if hi > lo:
-        # the row k that starts t's piece: the last of rows lo+1 .. hi-2 at or before t, else lo (a binary
-        # search: a sea state's path has 10^5 rows and every stage of every step looks one up)
+        # the row k that starts t_piece's piece: the last of rows lo+1 .. hi-2 at or before t_piece, else lo (a
+        # binary search: a sea state's path has 10^5 rows and every stage of every step looks one up)
         k, top = lo, hi - 2
         while k < top:
             mid = (k + top + 1) // 2
-            if m.path_t[mid] <= t:
+            if m.path_t[mid] <= t_piece:
                 k = mid
             else:
                 top = mid - 1
@@ -99,15 +110,16 @@ def offset(m, j, d, t):
 
 
 @jit.kernel
-def place_moving(x, v, held, t):
+def place_moving(x, v, held, t, t_piece):
     """Put every held node at its prescribed place at time t, set its velocity in ``v`` and in ``held.v``,
-    and its acceleration in ``held.motion.accel``."""
+    and its acceleration in ``held.motion.accel``; a path on its piece that holds ``t_piece`` (the middle of
+    the step a stage belongs to, or t itself for a step's end state; see the module doc)."""
     idx, x0, hv, m = held
     dim = x.shape[0]
     for j in range(idx.shape[0]):
         i = idx[j]
         for d in range(dim):
-            s, ds, dds = offset(m, j, d, t)
+            s, ds, dds = offset(m, j, d, t, t_piece)
             x[d, i] = x0[d, j] + m.base[d, j] * t + s
             hv[d, j] = m.base[d, j] + ds
             v[d, i] = hv[d, j]

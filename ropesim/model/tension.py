@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .forces.fluid import flow_at
 from .forces.springs import pair_spring_stretch, segment_forces
 from .motion import offset
 from .terms import accelerations
@@ -48,16 +49,30 @@ def support_forces(model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> np.nda
     mass = model.mass[idx][:, None]
     acc = np.zeros((model.dim, model.nodes))
     out = np.zeros((len(t), idx.size, model.dim))
+    forces = model.kernel(accelerations)
     for k in range(len(t)):
         xk, vk = np.ascontiguousarray(np.asarray(x[k]).T), np.ascontiguousarray(np.asarray(v[k]).T)
-        accelerations(xk, vk, acc, model.params, float(t[k]))
-        force = mass * acc[:, idx].T - (model.drag[idx][:, None] * vk[:, idx].T)
-        out[k] = -force
+        forces(xk, vk, acc, model.params, float(t[k]))
+        out[k] = -(mass * acc[:, idx].T + held_linear_drag(model, float(t[k]), xk, vk))
         if m.moving:
             for j in range(idx.size):
                 for d in range(model.dim):
-                    out[k, j, d] += mass[j, 0] * offset(m, j, d, float(t[k]))[2]
+                    out[k, j, d] += mass[j, 0] * offset(m, j, d, float(t[k]), float(t[k]))[2]
     return out
+
+
+def held_linear_drag(model, t: float, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The linear [drag]'s force [N] on each held node, -b (v - U) (H, D), U the [flow]'s velocity at the node
+    at time t [s] (none without a flow); ``x``, ``v`` one state (D, N). The compiled terms leave it out on held
+    nodes (their kick and the flow's push act on free nodes only), so a support's force adds it here."""
+    idx = model.held_idx
+    b = model.drag[idx]
+    relative = np.asarray(v[:, idx].T, dtype=float).copy()
+    if model.scene.flow is not None:
+        flow, table = model.params.flow
+        for j, i in enumerate(idx):
+            relative[j] -= np.asarray(flow_at(float(x[1, i]), t, flow, table))[:model.dim]
+    return -b[:, None] * relative
 
 
 def end_tensions(model, tension: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -2,9 +2,15 @@
 
 ``TERMS`` lists each term's :class:`~ropesim.model.forces.Term` record (its parameters and Python hooks);
 :class:`ModelParams` is the bundle of every term's parameters that the compiled code receives; and the
-compiled functions below call each term's kernel behind its flag. The rope's springs are always on; every
-other term runs only when the scene declares it, and an undeclared term receives empty parameters of the
-same types, so every scene compiles to one signature and reloads from Numba's cache.
+compiled functions below call each term's kernel behind its compile-time switch (``if WITH_SEABED:``, the
+term's :class:`~ropesim.model.jit.Switch`). The rope's springs are always on; every other term is compiled
+and runs only when the scene declares it: :func:`switches` gives a scene's switches, and
+:func:`ropesim.model.jit.specialise` the copy of a compiled function (and of every compiled function it
+calls) with the undeclared terms' branches removed before Numba types them. An undeclared term receives
+empty parameters of the same types, so the bundle has one layout for every scene.
+
+Besides one switch per optional term there are two derived from the term records (:data:`WITH_VELOCITY_TERMS`,
+:data:`WITH_APPLIED`), and :data:`WITH_MOTION` for held nodes with a prescribed motion.
 
 Compiled entry points, each the term list in one form:
 
@@ -26,23 +32,25 @@ from collections import namedtuple
 
 import numpy as np
 
-from .forces.added_mass import ADDED_MASS_TERM, add_added_mass_jacobian, apply_added_mass
-from .forces.bending import EI_TERM, add_ei_bending, add_ei_jacobian, ei_energy
-from .forces.buoyancy import BUOYANCY_TERM, add_buoyancy
+from .forces.added_mass import ADDED_MASS_TERM, WITH_ADDED_MASS, add_added_mass_jacobian, apply_added_mass
+from .forces.bending import EI_TERM, WITH_EI_BENDING, add_ei_bending, add_ei_jacobian, ei_energy
+from .forces.buoyancy import BUOYANCY_TERM, WITH_BUOYANCY, add_buoyancy
 from .forces.fluid import (BODY_DRAG_TERM, FLOW_PUSH_TERM, FLOW_TERM, FLUID_DRAG_TERM, VISCOUS_DRAG_TERM,
-                           add_fluid_forces, add_fluid_jacobian)
-from .forces.flow_inertia import FLOW_INERTIA_TERM, add_flow_inertia
+                           WITH_BODY_DRAG, WITH_FLOW_PUSH, WITH_FLUID_DRAG, WITH_VISCOUS_DRAG, add_fluid_forces,
+                           add_fluid_jacobian)
+from .forces.flow_inertia import FLOW_INERTIA_TERM, WITH_FLOW_INERTIA, add_flow_inertia
 from .forces.gravity import GRAVITY as GRAVITY_TERM
+from .forces.gravity import WITH_GRAVITY
 from .forces.guides import GUIDES as GUIDES_TERM
-from .forces.guides import add_guides, add_guides_jacobian
+from .forces.guides import WITH_GUIDES, add_guides, add_guides_jacobian
 from .forces.springs import AXIAL_DAMPING as AXIAL_DAMPING_TERM
 from .forces.springs import BENDING as BENDING_TERM
-from .forces.springs import ROPE
+from .forces.springs import ROPE, WITH_AXIAL_DAMPING, WITH_BENDING
 from .forces.springs import add_axial_damping, add_pair_springs, set_chain_springs
-from .forces.seabed import (SEABED_TERM, add_seabed_contact, add_seabed_friction, add_seabed_jacobian,
+from .forces.seabed import (SEABED_TERM, WITH_SEABED, add_seabed_contact, add_seabed_friction, add_seabed_jacobian,
                             seabed_energy)
 from .forces.thrower import THROWER as THROWER_TERM
-from .forces.thrower import add_thrower, add_thrower_jacobian
+from .forces.thrower import WITH_THROWER, add_thrower, add_thrower_jacobian
 from .jacobian import pair_damper_blocks, pair_spring_blocks
 from . import jit
 
@@ -50,36 +58,26 @@ TERMS = (ROPE, BENDING_TERM, GRAVITY_TERM, BUOYANCY_TERM, THROWER_TERM, GUIDES_T
          FLUID_DRAG_TERM, VISCOUS_DRAG_TERM, BODY_DRAG_TERM, FLOW_TERM, FLOW_PUSH_TERM, ADDED_MASS_TERM, SEABED_TERM,
          EI_TERM, FLOW_INERTIA_TERM)
 
-# Positions in ModelParams.flags (uint8), one per optional term: each Term's ``flag``.
-BENDING, GRAVITY, THROWER, GUIDES = BENDING_TERM.flag, GRAVITY_TERM.flag, THROWER_TERM.flag, GUIDES_TERM.flag
-AXIAL_DAMPING, BUOYANCY = AXIAL_DAMPING_TERM.flag, BUOYANCY_TERM.flag
-FLUID_DRAG, VISCOUS_DRAG, BODY_DRAG = FLUID_DRAG_TERM.flag, VISCOUS_DRAG_TERM.flag, BODY_DRAG_TERM.flag
-FLOW, FLOW_PUSH, ADDED_MASS = FLOW_TERM.flag, FLOW_PUSH_TERM.flag, ADDED_MASS_TERM.flag
-SEABED, EI_BENDING, FLOW_INERTIA = SEABED_TERM.flag, EI_TERM.flag, FLOW_INERTIA_TERM.flag
-N_FLAGS = 15
+WITH_VELOCITY_TERMS = jit.Switch("velocity_terms", "a term beyond the thrower's and guides' depends on velocity "
+                                                   "(Term.velocity)")
+WITH_APPLIED = jit.Switch("applied", "a term whose work the ledger books as box_work (the thrower, the guides)")
+WITH_MOTION = jit.Switch("motion", "a held node with a prescribed motion beyond x0 + V t")
 
 ModelParams = namedtuple("ModelParams", [
-    "inv_mass", "flags", "node_length", "spring", "bending", "gravity", "buoyancy", "thrower", "guides", "axial",
+    "inv_mass", "node_length", "spring", "bending", "gravity", "buoyancy", "thrower", "guides", "axial",
     "fluid_drag", "viscous_drag", "body_drag", "flow", "flow_push", "added_mass", "seabed", "bending_ei",
     "flow_inertia"])
-"""What the compiled code knows of the model's forces: 1 / m per node (N,), the on/off flags (N_FLAGS,), each
-node's share of unstretched length (N,) [m], and each term's parameters, in TERMS order (see each term's
-module for its layout)."""
+"""What the compiled code knows of the model's forces: 1 / m per node (N,), each node's share of unstretched
+length (N,) [m], and each term's parameters, in TERMS order (see each term's module for its layout)."""
 
 Layout = namedtuple("Layout", ["mass", "held", "node_length"])
 """What a term's ``params`` builder gets besides the scene: per-node mass [kg], held (bool) and length [m]."""
 
 
 def model_params(scene, layout: Layout) -> ModelParams:
-    """Every term's parameters for ``scene`` (empty ones for the terms it does not switch on) and the flags."""
-    flags = np.zeros(N_FLAGS, dtype=np.uint8)
-    values = []
-    for term in TERMS:
-        declared = term.declared(scene)
-        if declared and term.flag is not None:
-            flags[term.flag] = 1
-        values.append(term.params(scene, layout) if declared else term.empty())
-    return ModelParams(1.0 / layout.mass, flags, layout.node_length, *values)
+    """Every term's parameters for ``scene`` (empty ones for the terms it does not switch on)."""
+    values = [term.params(scene, layout) if term.declared(scene) else term.empty() for term in TERMS]
+    return ModelParams(1.0 / layout.mass, layout.node_length, *values)
 
 
 def declared_terms(scene) -> tuple:
@@ -87,32 +85,21 @@ def declared_terms(scene) -> tuple:
     return tuple(term for term in TERMS if term.declared(scene))
 
 
+def switches(scene) -> jit.Switches:
+    """The compile-time switches of ``scene``'s terms: each declared term's, and the two derived from their
+    records (velocity-dependent terms, terms booked as box work). :data:`WITH_MOTION` is the model's to add."""
+    declared = declared_terms(scene)
+    on = {term.switch.name for term in declared if term.switch is not None}
+    if any(term.velocity for term in declared):
+        on.add(WITH_VELOCITY_TERMS.name)
+    if any(term.ledger == "box" for term in declared):
+        on.add(WITH_APPLIED.name)
+    return frozenset(on)
+
+
 def coupling_reach(scene) -> int:
     """How far along the rope the scene's terms couple nodes (the Newton matrix's block half-width)."""
     return max(term.reach for term in declared_terms(scene))
-
-
-def velocity_terms_on(p: ModelParams) -> bool:
-    """True when a term beyond the thrower's and guides' depends on velocities (``Term.velocity``)."""
-    return any(p.flags[t.flag] for t in TERMS if t.velocity)
-
-
-def has_applied(p: ModelParams) -> bool:
-    """:func:`any_applied`, from Python without compiling."""
-    return bool(p.flags[THROWER] or p.flags[GUIDES])
-
-
-@jit.kernel(inline="always")
-def any_applied(flags):
-    """True when a term of the ledger's ``box_work`` (the thrower, the guides) is on."""
-    return flags[THROWER] != 0 or flags[GUIDES] != 0
-
-
-@jit.kernel(inline="always")
-def any_fluid(flags):
-    """True when a term acting through the fluid (drag on the relative velocity, a flow's push) is on."""
-    return (flags[FLUID_DRAG] != 0 or flags[VISCOUS_DRAG] != 0 or flags[BODY_DRAG] != 0
-            or flags[FLOW_PUSH] != 0)
 
 
 @jit.kernel(inline="always")
@@ -121,15 +108,15 @@ def position_accelerations(x, acc, p):
     Inlined into its callers, as :func:`velocity_accelerations` is: a call hands over the whole parameter bundle
     by value, which cost rk4 20 % on a 21-node rope."""
     closed = p.spring[2] != 0.0
-    g = p.gravity[0] if p.flags[GRAVITY] else 0.0
+    g = p.gravity[0] if WITH_GRAVITY else 0.0
     set_chain_springs(x, acc, p.inv_mass, p.spring[0], p.spring[1], closed, g, p.spring[3] != 0.0)
-    if p.flags[BENDING]:
+    if WITH_BENDING:
         add_pair_springs(x, acc, p.inv_mass, p.bending[0], p.bending[1], 2, closed)
-    if p.flags[BUOYANCY]:
+    if WITH_BUOYANCY:
         add_buoyancy(acc, p.buoyancy)
-    if p.flags[SEABED]:
+    if WITH_SEABED:
         add_seabed_contact(x, acc, p.inv_mass, p.seabed)
-    if p.flags[EI_BENDING]:
+    if WITH_EI_BENDING:
         add_ei_bending(x, acc, p.inv_mass, p.bending_ei, closed)
 
 
@@ -139,21 +126,21 @@ def velocity_accelerations(x, v, acc, p, t):
     axial damping, fluid forces, the accelerating water's, the seabed's damping and friction) at time t [s];
     returns the power [W] of the fluid, of the axial damping and of the seabed."""
     closed = p.spring[2] != 0.0
-    g = p.gravity[0] if p.flags[GRAVITY] else 0.0
-    if p.flags[THROWER]:
+    g = p.gravity[0] if WITH_GRAVITY else 0.0
+    if WITH_THROWER:
         add_thrower(x, v, acc, p.inv_mass, p.thrower, g)
-    if p.flags[GUIDES]:
-        add_guides(x, v, acc, p.guides, p.thrower, p.flags[THROWER] != 0, g)
+    if WITH_GUIDES:
+        add_guides(x, v, acc, p.guides, p.thrower, WITH_THROWER, g)
     internal = 0.0
-    if p.flags[AXIAL_DAMPING]:
+    if WITH_AXIAL_DAMPING:
         internal = add_axial_damping(x, v, acc, p.inv_mass, p.axial[0], closed)
     fluid = 0.0
-    if any_fluid(p.flags):
+    if WITH_FLUID_DRAG or WITH_VISCOUS_DRAG or WITH_BODY_DRAG or WITH_FLOW_PUSH:
         fluid = add_fluid_forces(x, v, acc, p, t)
-    if p.flags[FLOW_INERTIA]:
+    if WITH_FLOW_INERTIA:
         fluid += add_flow_inertia(x, v, acc, p.inv_mass, p.flow_inertia, p.flow, t, closed)
     seabed = 0.0
-    if p.flags[SEABED]:
+    if WITH_SEABED:
         seabed = add_seabed_friction(x, v, acc, p.inv_mass, p.seabed, closed)
     return fluid, internal, seabed
 
@@ -170,7 +157,7 @@ def accelerations(x, v, acc, p, t):
 def added_mass(x, v, acc, p):
     """With added mass on, turn ``acc`` (every force / m, drag included) into M^-1 F; returns the power [W] of
     the fluid's inertial force (0 without added mass)."""
-    if p.flags[ADDED_MASS]:
+    if WITH_ADDED_MASS:
         return apply_added_mass(x, v, acc, p.added_mass, p.inv_mass, p.spring[2] != 0.0)
     return 0.0
 
@@ -180,11 +167,11 @@ def applied_accelerations(x, v, out, p):
     """Overwrite ``out`` (D, N) with the non-conservative terms' part of the acceleration [m/s^2] alone (the
     thrower's and guides'); zero when none is on. The energy ledger books their work as ``box_work``."""
     out[:] = 0.0
-    g = p.gravity[0] if p.flags[GRAVITY] else 0.0
-    if p.flags[THROWER]:
+    g = p.gravity[0] if WITH_GRAVITY else 0.0
+    if WITH_THROWER:
         add_thrower(x, v, out, p.inv_mass, p.thrower, g)
-    if p.flags[GUIDES]:
-        add_guides(x, v, out, p.guides, p.thrower, p.flags[THROWER] != 0, g)
+    if WITH_GUIDES:
+        add_guides(x, v, out, p.guides, p.thrower, WITH_THROWER, g)
 
 
 @jit.kernel
@@ -219,20 +206,19 @@ def mechanical_energy(x, v, mass, p):
     dim, n = x.shape
     closed = p.spring[2] != 0.0
     e, stretch, node = _springs_energy_and_stretch(x, p.spring[0], p.spring[1], 1, closed, p.spring[3] != 0.0)
-    if p.flags[BENDING]:
+    if WITH_BENDING:
         e += _springs_energy_and_stretch(x, p.bending[0], p.bending[1], 2, closed, False)[0]
-    if p.flags[SEABED]:
+    if WITH_SEABED:
         e += seabed_energy(x, p.seabed)
-    if p.flags[EI_BENDING]:
+    if WITH_EI_BENDING:
         e += ei_energy(x, p.bending_ei, closed)
-    g = p.gravity[0] if p.flags[GRAVITY] else 0.0
-    buoyant = p.flags[BUOYANCY] != 0
+    g = p.gravity[0] if WITH_GRAVITY else 0.0
     for i in range(n):
         v2 = 0.0
         for d in range(dim):
             v2 += v[d, i] * v[d, i]
         e += 0.5 * mass[i] * v2 + mass[i] * g * x[1, i]
-        if buoyant:
+        if WITH_BUOYANCY:
             e -= mass[i] * p.buoyancy[i] * x[1, i]
     return e, stretch, node
 
@@ -244,11 +230,11 @@ def coupling_jacobian(x, jac, beta, free, p):
     closed = p.spring[2] != 0.0
     scale = beta * beta
     pair_spring_blocks(x, jac, p.spring[0], p.spring[1], 1, closed, scale, free, p.spring[3] != 0.0)
-    if p.flags[BENDING]:
+    if WITH_BENDING:
         pair_spring_blocks(x, jac, p.bending[0], p.bending[1], 2, closed, scale, free, False)
-    if p.flags[AXIAL_DAMPING]:
+    if WITH_AXIAL_DAMPING:
         pair_damper_blocks(x, jac, p.axial[0], closed, beta, free)
-    if p.flags[EI_BENDING]:
+    if WITH_EI_BENDING:
         add_ei_jacobian(x, jac, beta, free, p.bending_ei, p.spring[1], closed)
 
 
@@ -256,15 +242,15 @@ def coupling_jacobian(x, jac, beta, free, p):
 def node_jacobian(x, v, band, beta, mass, free, p, t):
     """Add the node-local terms' blocks (the thrower's, the guides', the fluid's, added mass) to the Newton
     matrix's ``band``, for a stage of coefficient beta = gamma h at time t (see :mod:`ropesim.model.jacobian`)."""
-    if p.flags[THROWER]:
+    if WITH_THROWER:
         add_thrower_jacobian(x, band, beta, mass, free, p.thrower)
-    if p.flags[GUIDES]:
-        add_guides_jacobian(x, v, band, beta, mass, free, p.guides, p.thrower, p.flags[THROWER] != 0)
-    if p.flags[FLUID_DRAG] or p.flags[VISCOUS_DRAG] or p.flags[BODY_DRAG]:
+    if WITH_GUIDES:
+        add_guides_jacobian(x, v, band, beta, mass, free, p.guides, p.thrower, WITH_THROWER)
+    if WITH_FLUID_DRAG or WITH_VISCOUS_DRAG or WITH_BODY_DRAG:
         add_fluid_jacobian(x, v, band, beta, free, p, t)
-    if p.flags[ADDED_MASS]:
+    if WITH_ADDED_MASS:
         add_added_mass_jacobian(x, band, p.added_mass, free, p.spring[2] != 0.0)
-    if p.flags[SEABED]:
+    if WITH_SEABED:
         add_seabed_jacobian(x, v, band, beta, free, p.seabed, True)
 
 

@@ -4,6 +4,8 @@ Every run: the mechanical energy term by term [J], and the largest relative spri
 over time. A towed rope (the helicopter scenes): the angle from vertical of every segment along the rope at
 the last frame, against the exact discrete steady state. A string shooter: the loop's inclination over time.
 Per-frame series are computed in blocks of frames, so a memory-mapped run of any length can be plotted.
+``start``/``stop`` (``--from``/``--to``) plot a window of the run, its ranges and extremes over that window;
+forces are in kN where they reach kilonewtons.
 """
 
 from __future__ import annotations
@@ -80,6 +82,8 @@ def draw_ledger(ax, traj: Trajectory, model: Model) -> None:
         ax.set_title("Energy ledger")
         return
     flows, energy0 = stored
+    if traj.ledger is not None:   # the frames' own flows (a window of the run has only its own)
+        flows = traj.ledger
     n = min(len(flows), traj.frames)
     series = ledger_series(model, traj.x, traj.v, flows[:n], energy0)
     t = traj.t[:n]
@@ -147,12 +151,15 @@ def draw_inclination(ax, traj: Trajectory, model: Model) -> None:
 
 def draw_end_tensions(ax, traj: Trajectory, model: Model) -> None:
     """The tension in the rope's first and last segments over time."""
-    tension = traj.tension
-    ax.plot(traj.t, np.asarray(tension[:, 0]), linewidth=1.1, label="segment 0 (at node 0)")
-    if tension.shape[1] > 1:
-        ax.plot(traj.t, np.asarray(tension[:, -1]), linewidth=1.1, label=f"segment {tension.shape[1] - 1} (the other end)")
+    from ..analysis.tension import force_unit
+
+    ends = np.asarray(traj.tension[:, [0, -1]])
+    unit, scale = force_unit(float(np.nanmax(np.abs(ends), initial=0.0)))
+    ax.plot(traj.t, ends[:, 0] / scale, linewidth=1.1, label="segment 0 (at node 0)")
+    if traj.tension.shape[1] > 1:
+        ax.plot(traj.t, ends[:, 1] / scale, linewidth=1.1, label=f"segment {traj.tension.shape[1] - 1} (the other end)")
     ax.axhline(0, color="0.6", linewidth=0.8)
-    ax.set_ylabel("tension [N]")
+    ax.set_ylabel(f"tension [{unit}]")
     ax.set_title("Tension at the rope's ends")
     ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
@@ -167,11 +174,15 @@ def draw_tension_profile(ax, traj: Trajectory, model: Model) -> None:
     for s in range(0, len(traj.t), step):
         block = np.asarray(tension[s:s + step])
         low, high = np.minimum(low, np.nanmin(block, axis=0)), np.maximum(high, np.nanmax(block, axis=0))
-    ax.fill_between(along, low, high, color="#1f77b4", alpha=0.2, linewidth=0, label="range over the run")
-    ax.plot(along, np.asarray(tension[i]), "o-", markersize=3, color="#1f77b4", label=f"t = {traj.t[i]:.3g} s")
+    from ..analysis.tension import force_unit
+
+    unit, scale = force_unit(float(np.nanmax(np.abs(high), initial=0.0)))
+    span = f"t = {traj.t[0]:.3g} .. {traj.t[-1]:.3g} s"
+    ax.fill_between(along, low / scale, high / scale, color="#1f77b4", alpha=0.2, linewidth=0, label=f"range, {span}")
+    ax.plot(along, np.asarray(tension[i]) / scale, "o-", markersize=3, color="#1f77b4", label=f"t = {traj.t[i]:.3g} s")
     ax.axhline(0, color="0.6", linewidth=0.8)
     ax.set_xlabel("distance along the rope from node 0 (at rest) [m]")
-    ax.set_ylabel("tension [N]")
+    ax.set_ylabel(f"tension [{unit}]")
     ax.set_title("Tension along the rope")
     ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
@@ -207,10 +218,30 @@ class Plot:
     size: tuple[int, int]  # (width, height) [px]
 
 
-def run_figure(traj: Trajectory):
+def windowed(traj: Trajectory, start: float | None, stop: float | None) -> Trajectory:
+    """``traj`` cut to the frames with start <= t <= stop (views, nothing copied); ValueError when none is left."""
+    from dataclasses import replace
+
+    from ..analysis.tension import frame_window
+
+    if start is None and stop is None:
+        return traj
+    sl = frame_window(traj.t, start, stop)
+    cut = {name: getattr(traj, name)[sl] for name in ("t", "x", "v", "tension", "strain", "support", "ledger")
+           if getattr(traj, name) is not None}
+    return replace(traj, **cut)
+
+
+def run_figure(traj: Trajectory, start: float | None = None, stop: float | None = None):
     """The figure of :func:`plot_run` and the names of its panels (every :data:`PANELS` entry that applies)."""
     from matplotlib.figure import Figure
 
+    from . import RenderError
+
+    try:
+        traj = windowed(traj, start, stop)
+    except ValueError as exc:
+        raise RenderError(str(exc)) from None
     model = build(traj.scene)
     panels = [p for p in PANELS if p.applies(model) and (traj.tension is not None or not p.needs_tension)]
     height = HEADER + PANEL_HEIGHT * len(panels)
@@ -233,13 +264,14 @@ def run_figure(traj: Trajectory):
 
 
 @with_picture_text
-def plot_run(traj: Trajectory, out: str | Path) -> Plot:
-    """Write the run's figures (every :data:`PANELS` entry that applies to its scene) to the PNG ``out``."""
+def plot_run(traj: Trajectory, out: str | Path, start: float | None = None, stop: float | None = None) -> Plot:
+    """Write the run's figures (every :data:`PANELS` entry that applies to its scene) to the PNG ``out``; with
+    ``start``/``stop`` [s], of that window of the run alone."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     out = Path(out)
     real, _ = output_path(out, (".png",))
-    fig, panels = run_figure(traj)
+    fig, panels = run_figure(traj, start, stop)
     FigureCanvasAgg(fig)
     save_png(fig, real, DPI)
     width, height = (round(v) for v in fig.bbox.size)

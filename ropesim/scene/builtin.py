@@ -2,7 +2,7 @@
 
 A command's SCENE argument is a scene file, or the name of a built-in scene: an argument that is not an
 existing file and names a built-in (``helicopter_mass`` or ``helicopter_mass.toml``) means that built-in,
-so ``ropesim run helicopter_mass`` works from any folder and after ``pip install ropesim`` from a wheel.
+so ``ropesim run helicopter_mass`` works from any folder and after ``pip install pyropesim`` from a wheel.
 A path that exists always wins over a name. Anything else is refused in one line that lists the built-ins
 and suggests the closest name.
 """

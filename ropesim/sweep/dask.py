@@ -4,7 +4,7 @@ Each worker resolves the scene from its TOML text and runs it with :func:`ropesi
 temporary folder of its own, then sends back the run's arrays, scene and summary; this process writes them
 into the sweep's run folder with the usual atomic writes. So workers need ropesim installed but no file
 system shared with this machine, and the runs (deterministic, like every ropesim run) give the same arrays
-bit for bit as a local sweep. Needs the ``dask`` extra: ``pip install "ropesim[dask]"``.
+bit for bit as a local sweep. Needs the ``dask`` extra (:func:`ropesim.install.install_hint` says how to install it).
 """
 
 from __future__ import annotations
@@ -51,8 +51,9 @@ def run_dask(todo: list[tuple[Point, Path]], address: str) -> Iterator[Outcome]:
     try:
         from dask.distributed import Client, as_completed
     except ImportError:
-        raise SweepError('--scheduler needs dask.distributed, which is not installed: '
-                         'pip install "ropesim[dask]"') from None
+        from ..install import install_hint
+
+        raise SweepError(f"--scheduler needs dask.distributed, which is not installed: {install_hint('dask')}") from None
     try:
         client = Client(address, timeout=CONNECT_TIMEOUT, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:

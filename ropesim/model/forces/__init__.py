@@ -2,7 +2,7 @@
 
 Every term is a compiled kernel that *adds* its acceleration [m/s^2] to ``acc``. State arrays are
 structure-of-arrays: ``x``, ``v`` and ``acc`` have shape (D, N), so each coordinate is contiguous. The compiled
-term list that calls the kernels, each behind its flag, is :mod:`ropesim.model.terms`; the Python side of
+term list that calls the kernels, each behind its switch, is :mod:`ropesim.model.terms`; the Python side of
 each term (its parameters, its energy, what it does to the stability bound) is its :class:`Term` record,
 listed in ``ropesim.model.terms.TERMS``. Adding a term is described in ``CONTRIBUTING.md``.
 
@@ -17,6 +17,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..jit import Switch
+
 
 def _none(*_args) -> None:
     return None
@@ -30,9 +32,12 @@ def _zero(*_args) -> float:
 class Term:
     """What ropesim needs to know about one force term, besides its compiled kernel.
 
-    ``params(scene, mass)`` builds the term's parameters (a float64 array, or a tuple of arrays) for a scene
-    that declares the term, and ``empty`` is what an undeclared term gets instead: the same types, so every
-    scene compiles to one signature. The hooks, each optional:
+    ``switch`` is the term's compile-time :class:`~ropesim.model.jit.Switch` (None for a term that is always
+    on): the term list calls the term's kernel behind it (``if WITH_SEABED:``), so a scene that does not declare
+    the term never compiles its kernel (:func:`ropesim.model.jit.specialise`). ``params(scene, mass)`` builds
+    the term's parameters (a float64 array, or a tuple of arrays) for a scene that declares the term, and
+    ``empty`` is what an undeclared term gets instead: the same types, so the parameter bundle has one layout
+    for every scene. The hooks, each optional:
 
     - ``energy(model, x)``: a conservative term's potential energy [J] for frames x (..., N, D), as NumPy
       (the analyses, the energy ledger's E(t) and the blow-up check's energy scale use it; the compiled check
@@ -56,7 +61,7 @@ class Term:
     """
 
     name: str                                   # the scene's table (or array of tables) that declares it
-    flag: int | None                            # its index in ModelParams.flags; None: always on
+    switch: Switch | None                       # its compile-time switch; None: always on
     params: Callable[[Any, np.ndarray], Any]
     empty: Callable[[], Any]
     energy: Callable | None = None
@@ -71,7 +76,7 @@ class Term:
 
     def declared(self, scene) -> bool:
         """True when ``scene`` switches this term on (or the term is always on)."""
-        if self.flag is None:
+        if self.switch is None:
             return True
         if self.active is not None:
             return bool(self.active(scene))

@@ -19,7 +19,7 @@ from . import Term
 from .fluid import node_tangent
 from .. import jit
 
-ADDED_MASS = 11   # its flag
+WITH_ADDED_MASS = jit.Switch("added_mass", "the fluid's added mass")
 
 
 @jit.kernel
@@ -88,6 +88,6 @@ def _params(scene, layout) -> np.ndarray:
     return added
 
 
-ADDED_MASS_TERM = Term("added_mass", ADDED_MASS, _params, lambda: np.zeros((2, 0)), ledger="fluid", velocity=True,
+ADDED_MASS_TERM = Term("added_mass", WITH_ADDED_MASS, _params, lambda: np.zeros((2, 0)), ledger="fluid", velocity=True,
                        active=lambda scene: scene.added_mass is not None or any(b.ca > 0 for b in scene.bodies))
 """Added mass (it needs no force of its own: it changes how every force accelerates a node)."""

@@ -35,7 +35,7 @@ from . import Term
 from ..jacobian import add_pair
 from .. import jit
 
-EI_BENDING = 13   # its flag
+WITH_EI_BENDING = jit.Switch("ei_bending", "bending stiffness EI")
 
 
 @jit.kernel
@@ -218,7 +218,7 @@ def _stiffness(model) -> float:
     return float(np.max(16.0 * np.maximum(c, np.roll(c, 1))[free] / (l0 * l0 * model.mass[free]), initial=0.0))
 
 
-EI_TERM = Term("rope", EI_BENDING, _params, lambda: (np.zeros(0), np.zeros((2, 3))),
+EI_TERM = Term("rope", WITH_EI_BENDING, _params, lambda: (np.zeros(0), np.zeros((2, 3))),
                energy=_energy, node_stiffness=_stiffness, active=lambda scene: bool(scene.rope.EI), reach=2,
                label="bending EI")
 """The rope's bending stiffness EI (``rope.EI``)."""

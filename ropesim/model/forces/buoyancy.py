@@ -14,7 +14,7 @@ import numpy as np
 from . import Term
 from .. import jit
 
-BUOYANCY = 5   # its flag
+WITH_BUOYANCY = jit.Switch("buoyancy", "buoyancy")
 
 
 @jit.kernel
@@ -41,4 +41,4 @@ def buoyancy_energy(model, x: np.ndarray) -> np.ndarray:
     return -np.einsum("...n,n->...", np.asarray(x)[..., 1], model.mass * model.params.buoyancy)
 
 
-BUOYANCY_TERM = Term("buoyancy", BUOYANCY, _params, lambda: np.zeros(0), energy=buoyancy_energy)
+BUOYANCY_TERM = Term("buoyancy", WITH_BUOYANCY, _params, lambda: np.zeros(0), energy=buoyancy_energy)

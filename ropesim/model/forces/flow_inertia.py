@@ -35,7 +35,7 @@ from .buoyancy import displaced_volume
 from .fluid import flow_scaled, node_tangent
 from .. import jit
 
-FLOW_INERTIA = 14   # its flag
+WITH_FLOW_INERTIA = jit.Switch("flow_inertia", "the accelerating water's inertia force")
 
 
 @jit.kernel
@@ -90,7 +90,7 @@ def _active(scene) -> bool:
             and (scene.buoyancy is not None or ADDED_MASS_TERM.declared(scene)))
 
 
-FLOW_INERTIA_TERM = Term("flow", FLOW_INERTIA, _params, lambda: np.zeros((2, 0)), ledger="fluid", velocity=True,
+FLOW_INERTIA_TERM = Term("flow", WITH_FLOW_INERTIA, _params, lambda: np.zeros((2, 0)), ledger="fluid", velocity=True,
                          active=_active)
 """Morison's inertia term while the flow ramps in (time-dependent, so the splitting schemes integrate it in
 their RK4 velocity kicks with the drag)."""

@@ -33,7 +33,11 @@ import numpy as np
 from . import Term
 from .. import jit
 
-FLUID_DRAG, VISCOUS_DRAG, BODY_DRAG, FLOW, FLOW_PUSH = 6, 7, 8, 9, 10   # their flags (Term.flag below)
+WITH_FLUID_DRAG = jit.Switch("fluid_drag", "Morison quadratic drag")
+WITH_VISCOUS_DRAG = jit.Switch("viscous_drag", "linear anisotropic drag")
+WITH_BODY_DRAG = jit.Switch("body_drag", "point bodies' drag")
+WITH_FLOW = jit.Switch("flow", "an ambient flow")
+WITH_FLOW_PUSH = jit.Switch("flow_push", "a flow's push on the linear drag")
 UNIFORM, POWER_LAW, TABLE = 0, 1, 2
 PROFILES = {"uniform": UNIFORM, "power_law": POWER_LAW, "table": TABLE}
 FLOW_PARAMS = 8
@@ -107,44 +111,41 @@ def add_fluid_forces(x, v, acc, p, t):
     their power [W] on the rope (held nodes included: their supports take it)."""
     dim, n = x.shape
     closed = p.spring[2] != 0.0
-    flags = p.flags
-    quadratic, linear, body, moving, push = (flags[FLUID_DRAG] != 0, flags[VISCOUS_DRAG] != 0,
-                                             flags[BODY_DRAG] != 0, flags[FLOW] != 0, flags[FLOW_PUSH] != 0)
     c_n, c_t = p.fluid_drag[0], p.fluid_drag[1]
     b_n, b_t = p.viscous_drag[0], p.viscous_drag[1]
     flow, table = p.flow
     power = 0.0
     for i in range(n):
         ux = uy = uz = 0.0
-        if moving:
+        if WITH_FLOW:
             ux, uy, uz = flow_at(x[1, i], t, flow, table)
         rx = v[0, i] - ux
         ry = v[1, i] - uy
         rz = v[2, i] - uz if dim == 3 else 0.0
         fx = fy = fz = 0.0
-        if quadratic or linear:
+        if WITH_FLUID_DRAG or WITH_VISCOUS_DRAG:
             qx, qy, qz = node_tangent(x, i, closed)
             along = rx * qx + ry * qy + rz * qz
             tx, ty, tz = along * qx, along * qy, along * qz
             nx, ny, nz = rx - tx, ry - ty, rz - tz
             length = p.node_length[i]
-            if quadratic:
+            if WITH_FLUID_DRAG:
                 cn = c_n * length * math.sqrt(nx * nx + ny * ny + nz * nz)
                 ct = c_t * length * abs(along)
                 fx -= cn * nx + ct * tx
                 fy -= cn * ny + ct * ty
                 fz -= cn * nz + ct * tz
-            if linear:
+            if WITH_VISCOUS_DRAG:
                 fx -= length * (b_n * nx + b_t * tx)
                 fy -= length * (b_n * ny + b_t * ty)
                 fz -= length * (b_n * nz + b_t * tz)
-        if body and p.body_drag[i] > 0.0:
+        if WITH_BODY_DRAG and p.body_drag[i] > 0.0:
             cb = p.body_drag[i] * math.sqrt(rx * rx + ry * ry + rz * rz)
             fx -= cb * rx
             fy -= cb * ry
             fz -= cb * rz
         inv_m = p.inv_mass[i]
-        if push:   # + b U, as an acceleration (b / m) U
+        if WITH_FLOW_PUSH:   # + b U, as an acceleration (b / m) U
             fx += p.flow_push[i] * ux / inv_m
             fy += p.flow_push[i] * uy / inv_m
             fz += p.flow_push[i] * uz / inv_m
@@ -168,9 +169,6 @@ def add_fluid_jacobian(x, v, band, beta, free, p, t):
     """
     dim, n = x.shape
     closed = p.spring[2] != 0.0
-    flags = p.flags
-    quadratic, linear, body, moving = (flags[FLUID_DRAG] != 0, flags[VISCOUS_DRAG] != 0, flags[BODY_DRAG] != 0,
-                                       flags[FLOW] != 0)
     flow, table = p.flow
     c_n, c_t = p.fluid_drag[0], p.fluid_drag[1]
     b_n, b_t = p.viscous_drag[0], p.viscous_drag[1]
@@ -178,34 +176,99 @@ def add_fluid_jacobian(x, v, band, beta, free, p, t):
         if not free[i]:
             continue
         ux = uy = uz = 0.0
-        if moving:
+        if WITH_FLOW:
             ux, uy, uz = flow_at(x[1, i], t, flow, table)
         r = (v[0, i] - ux, v[1, i] - uy, v[2, i] - uz if dim == 3 else 0.0)
         q = (0.0, 0.0, 0.0)
         nv = (0.0, 0.0, 0.0)
         along = speed_n = length = 0.0
-        if quadratic or linear:
+        if WITH_FLUID_DRAG or WITH_VISCOUS_DRAG:
             q = node_tangent(x, i, closed)
             along = r[0] * q[0] + r[1] * q[1] + r[2] * q[2]
             nv = (r[0] - along * q[0], r[1] - along * q[1], r[2] - along * q[2])
             speed_n = math.sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2])
             length = p.node_length[i]
-        c_b = p.body_drag[i] if body else 0.0
+        c_b = p.body_drag[i] if WITH_BODY_DRAG else 0.0
         speed = math.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) if c_b > 0.0 else 0.0
         for a in range(dim):
             for b in range(a + 1):
                 unit = 1.0 if a == b else 0.0
                 qq = q[a] * q[b]
                 c = 0.0
-                if quadratic:
+                if WITH_FLUID_DRAG:
                     c += c_n * length * speed_n * (unit - qq) + 2.0 * c_t * length * abs(along) * qq
                     if speed_n > 0.0:
                         c += c_n * length * nv[a] * nv[b] / speed_n
-                if linear:
+                if WITH_VISCOUS_DRAG:
                     c += length * (b_n * (unit - qq) + b_t * qq)
                 if speed > 0.0:
                     c += c_b * (speed * unit + r[a] * r[b] / speed)
                 band[a - b, i * dim + b] += beta * c
+
+
+@jit.kernel
+def add_fluid_tangent_stiffness(x, v, blocks, free, p, t):
+    """Add the drag's stiffness through the node tangent, K = -dF_i/dx_j, to ``blocks`` (N, 3, D, D): node i's
+    block for its neighbour before it (round a loop), itself and the one after. :func:`add_fluid_jacobian`
+    freezes the tangent q; for the static solver this is the missing part of Newton's matrix, and for a line
+    hanging in a current it is as large as the springs' own sideways stiffness (:mod:`ropesim.model.statics`).
+
+    With u = v - U, a = u . q, u_n = u - a q and W = q u^T + a I (= d(a q)/dq):
+    dF/dq = c_n L (|u_n| W + a u_n u_n^T / |u_n|) - c_t L (2 |a| q u^T + |a| a I) + L (b_n - b_t) W, and
+    q = (x_hi - x_lo) / r gives dF/dx_hi = -dF/dx_lo = dF/dq (I - q q^T) / r. Not symmetric: the static
+    solver applies it beside the banded matrix rather than in it. Held rows are skipped; the caller leaves out
+    held columns.
+    """
+    dim, n = x.shape
+    closed = p.spring[2] != 0.0
+    flow, table = p.flow
+    c_n, c_t = p.fluid_drag[0], p.fluid_drag[1]
+    b_n, b_t = p.viscous_drag[0], p.viscous_drag[1]
+    for i in range(n):
+        if not free[i]:
+            continue
+        lo, hi = i - 1, i + 1
+        if lo < 0:
+            lo = n - 1 if closed else 0
+        if hi >= n:
+            hi = 0 if closed else n - 1
+        e0, e1 = x[0, hi] - x[0, lo], x[1, hi] - x[1, lo]
+        e2 = x[2, hi] - x[2, lo] if dim == 3 else 0.0
+        r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        if r == 0.0:
+            continue
+        q = (e0 / r, e1 / r, e2 / r)
+        ux = uy = uz = 0.0
+        if WITH_FLOW:
+            ux, uy, uz = flow_at(x[1, i], t, flow, table)
+        u = (v[0, i] - ux, v[1, i] - uy, v[2, i] - uz if dim == 3 else 0.0)
+        a = u[0] * q[0] + u[1] * q[1] + u[2] * q[2]
+        un = (u[0] - a * q[0], u[1] - a * q[1], u[2] - a * q[2])
+        sn = math.sqrt(un[0] * un[0] + un[1] * un[1] + un[2] * un[2])
+        cn = c_n * p.node_length[i] if WITH_FLUID_DRAG else 0.0
+        ct = c_t * p.node_length[i] if WITH_FLUID_DRAG else 0.0
+        lin = p.node_length[i] * (b_n - b_t) if WITH_VISCOUS_DRAG else 0.0
+        before = 0 if lo != i else 1
+        after = 2 if hi != i else 1
+        for j in range(dim):
+            mq = 0.0
+            for k in range(3):
+                mq += _drag_by_tangent(j, k, q, u, a, un, sn, cn, ct, lin) * q[k]
+            for k in range(dim):
+                stiffness = (_drag_by_tangent(j, k, q, u, a, un, sn, cn, ct, lin) - mq * q[k]) / r   # dF_j/dx_hi,k
+                blocks[i, after, j, k] -= stiffness
+                blocks[i, before, j, k] += stiffness
+
+
+@jit.kernel(inline="always")
+def _drag_by_tangent(j, k, q, u, a, un, sn, cn, ct, lin):
+    """dF_j/dq_k of a node's drag (see :func:`add_fluid_tangent_stiffness`); cn = c_n L, ct = c_t L, lin =
+    L (b_n - b_t)."""
+    w = q[j] * u[k] + (a if j == k else 0.0)
+    m = cn * sn * w + lin * w
+    if sn > 0.0:
+        m += cn * a * un[j] * un[k] / sn
+    return m - ct * (2.0 * abs(a) * q[j] * u[k] + (abs(a) * a if j == k else 0.0))
 
 
 def speed_scale(model) -> float:
@@ -270,21 +333,21 @@ def _flow_push(scene, layout) -> np.ndarray:
     return np.where(layout.held, 0.0, b / layout.mass)
 
 
-FLUID_DRAG_TERM = Term("fluid_drag", FLUID_DRAG, _fluid_drag, lambda: np.zeros(2), damping=_quadratic_rate,
+FLUID_DRAG_TERM = Term("fluid_drag", WITH_FLUID_DRAG, _fluid_drag, lambda: np.zeros(2), damping=_quadratic_rate,
                        ledger="fluid", velocity=True)
 VISCOUS_DRAG_TERM = Term(
-    "viscous_drag", VISCOUS_DRAG, lambda scene, layout: np.array([scene.viscous_drag.b_normal,
+    "viscous_drag", WITH_VISCOUS_DRAG, lambda scene, layout: np.array([scene.viscous_drag.b_normal,
                                                                   scene.viscous_drag.b_tangential]),
     lambda: np.zeros(2), ledger="fluid", velocity=True,
     damping=lambda model: float(np.max(max(model.params.viscous_drag) * model.params.node_length[~model.held]
                                        / model.mass[~model.held], initial=0.0)))
 BODY_DRAG_TERM = Term(
-    "bodies", BODY_DRAG, _body_drag, lambda: np.zeros(0), ledger="fluid", velocity=True,
+    "bodies", WITH_BODY_DRAG, _body_drag, lambda: np.zeros(0), ledger="fluid", velocity=True,
     active=lambda scene: any(b.cd_area > 0 for b in scene.bodies),
     damping=lambda model: float(np.max(2.0 * model.params.body_drag * speed_scale(model) / model.mass,
                                        initial=0.0)))
-FLOW_TERM = Term("flow", FLOW, _flow, lambda: (np.zeros(FLOW_PARAMS), np.zeros((0, 4))))
+FLOW_TERM = Term("flow", WITH_FLOW, _flow, lambda: (np.zeros(FLOW_PARAMS), np.zeros((0, 4))))
 """The flow field itself: no force of its own (the drag terms act on the velocity relative to it)."""
-FLOW_PUSH_TERM = Term("drag", FLOW_PUSH, _flow_push, lambda: np.zeros(0), ledger="fluid", velocity=True,
+FLOW_PUSH_TERM = Term("drag", WITH_FLOW_PUSH, _flow_push, lambda: np.zeros(0), ledger="fluid", velocity=True,
                       active=lambda scene: scene.flow is not None and scene.drag is not None)
 """The flow's push on the linear [drag]: + b U per node."""

@@ -10,6 +10,9 @@ from __future__ import annotations
 import numpy as np
 
 from . import Term
+from ..jit import Switch
+
+WITH_GRAVITY = Switch("gravity", "uniform gravity along -y")
 
 
 def gravitational_energy(model, x: np.ndarray) -> np.ndarray:
@@ -17,5 +20,5 @@ def gravitational_energy(model, x: np.ndarray) -> np.ndarray:
     return model.scene.gravity.g * np.einsum("...n,n->...", np.asarray(x)[..., 1], model.mass)
 
 
-GRAVITY = Term("gravity", 1, lambda scene, mass: np.array([scene.gravity.g]), lambda: np.zeros(1),
+GRAVITY = Term("gravity", WITH_GRAVITY, lambda scene, mass: np.array([scene.gravity.g]), lambda: np.zeros(1),
                energy=gravitational_energy)

@@ -20,6 +20,7 @@ from . import Term
 from .thrower import box_of, smooth_step, weight_at
 from .. import jit
 
+WITH_GUIDES = jit.Switch("guides", "guide circles")
 GUIDE_PARAMS = 7
 
 
@@ -115,7 +116,7 @@ def _omega0(model, guide) -> float:
         scene.thrower.resolved_omega0 if scene.thrower is not None else 0.0)
 
 
-GUIDES = Term("guides", 3, _params, lambda: np.zeros((0, GUIDE_PARAMS)),
+GUIDES = Term("guides", WITH_GUIDES, _params, lambda: np.zeros((0, GUIDE_PARAMS)),
               node_stiffness=lambda model: max(_omega0(model, g) * _omega0(model, g) for g in model.scene.guides),
               damping=lambda model: max(2 * g.damping_ratio * _omega0(model, g) for g in model.scene.guides),
               ledger="box")

@@ -38,7 +38,7 @@ from . import Term
 from .fluid import node_tangent
 from .. import jit
 
-SEABED = 12   # its flag
+WITH_SEABED = jit.Switch("seabed", "the seabed's contact and friction")
 SEABED_PARAMS = 11
 DAMPING_DEPTH = 1e-3   # delta_d / the footprint's width: the depth over which the contact damping grows
 
@@ -187,7 +187,7 @@ def _damping(model) -> float:
     return float(np.max(bed[5] * area / model.mass, initial=0.0)) + max(bed[6], bed[7]) * g / bed[8]
 
 
-SEABED_TERM = Term("seabed", SEABED, _params, lambda: (np.zeros(SEABED_PARAMS), np.zeros(0)), energy=_energy,
+SEABED_TERM = Term("seabed", WITH_SEABED, _params, lambda: (np.zeros(SEABED_PARAMS), np.zeros(0)), energy=_energy,
                    node_stiffness=_stiffness, damping=_damping, ledger="seabed", velocity=True, label="seabed")
 """The seabed: its contact spring (conservative: ``energy``) in the positions-only part of the term list, its
 damping and friction (booked as ``seabed_work``) in the velocity part."""

@@ -16,6 +16,9 @@ import numpy as np
 from . import Term
 from .. import jit
 
+WITH_AXIAL_DAMPING = jit.Switch("axial_damping", "the segments' axial damping")
+WITH_BENDING = jit.Switch("bending", "second-neighbour bending springs")
+
 
 @jit.kernel
 def add_pair_springs(x, acc, inv_mass, k, rest, stride, closed):
@@ -213,14 +216,14 @@ ROPE = Term(
 """The rope's own springs (i, i + 1): parameters k [N/m], rest length l [m], closed (1) or open (0), slack (1)."""
 
 AXIAL_DAMPING = Term(
-    "rope", 4, lambda scene, mass: np.array([scene.rope.axial_damping / scene.rope.segment_length]),
+    "rope", WITH_AXIAL_DAMPING, lambda scene, mass: np.array([scene.rope.axial_damping / scene.rope.segment_length]),
     lambda: np.zeros(1), active=lambda scene: bool(scene.rope.axial_damping),
     damping=lambda model: 4.0 * model.scene.rope.axial_damping / model.scene.rope.segment_length
     / float(model.mass[~model.held].min()), ledger="internal", velocity=True)
 """The segments' internal damping: parameter c = BA / l [N s/m]."""
 
 BENDING = Term(
-    "bending", 0, _bending_params, lambda: np.zeros(2),
+    "bending", WITH_BENDING, _bending_params, lambda: np.zeros(2),
     energy=lambda model, x: pair_spring_energy(x, model.scene.bending.stiffness, 2 * model.scene.rope.segment_length,
                                                2, model.scene.rope.closed),
     springs=lambda model: [(2, model.scene.bending.stiffness)], reach=2)

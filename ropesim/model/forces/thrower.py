@@ -28,6 +28,7 @@ import numpy as np
 from . import Term
 from .. import jit
 
+WITH_THROWER = jit.Switch("thrower", "the string shooter's drive box")
 THROWER_PARAMS = 12
 SMOOTH_CUTOFF = 20.0  # beyond 20 widths tanh is 1 to double precision: the weight is exactly 0 or 1
 
@@ -181,5 +182,5 @@ def _empty() -> np.ndarray:
     return p
 
 
-THROWER = Term("thrower", 2, _params, _empty,
+THROWER = Term("thrower", WITH_THROWER, _params, _empty,
                node_stiffness=lambda model: model.scene.thrower.resolved_omega0 * model.scene.thrower.resolved_omega0, damping=_damping, ledger="box")
