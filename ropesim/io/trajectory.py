@@ -150,9 +150,16 @@ class Trajectory:
         from ..render.notebook import inline_animation
         return inline_animation(self, **options)
 
+    def view(self, **options):
+        """The run in the browser viewer (`ropesim view`'s page, see :func:`ropesim.viewer.page.make_page` for
+        ``every``, ``start``, ``end``): a notebook shows it in a sandboxed iframe, ``.save(path)`` writes it."""
+        from ..viewer.page import NOTEBOOK_BUDGET, make_page
+        return make_page(self, **{"budget": NOTEBOOK_BUDGET, **options})
+
     def _repr_html_(self) -> str:
+        """In Jupyter: the short summary table, and the run in the viewer below it."""
         from ..render.notebook import summary_html
-        return summary_html(self)
+        return summary_html(self) + self.view()._repr_html_()
 
     def __repr__(self) -> str:
         return (f"Trajectory(scene={self.scene.name!r}, {self.summary.get('status', 'completed')}, "
