@@ -4,8 +4,8 @@
 The browser is Debian's ``chromium`` (``apt-get install chromium``; ROPESIM_CHROMIUM names another binary),
 never one ``playwright install`` downloads: the ``playwright`` package (the test extra) only drives it. Each
 session starts it with a fresh profile in a temporary folder and no background traffic of its own (no
-component updates, sync or field trials), software WebGL, and every request that is not the page's own file
-refused and recorded, so a page that reaches for the network fails its test.
+component updates, no sync), software WebGL, and every request that is not the page's own file refused and
+recorded, so a page that reaches for the network fails its test.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
+import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,10 +21,21 @@ from typing import Iterator
 
 CHROMIUM = "/usr/bin/chromium"
 ARGS = ("--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update",
-        "--no-first-run", "--disable-sync", "--disable-default-apps", "--disable-domain-reliability",
-        "--disable-features=OptimizationHints,MediaRouter,Translate", "--metrics-recording-only",
-        "--enable-unsafe-swiftshader")
-READY_TIMEOUT_MS = 30_000
+        "--no-first-run", "--disable-sync")      # headless, software WebGL, no traffic of its own
+READY_TIMEOUT = 30.0    # [s]
+READY = "window.ropesim && (window.ropesim.firstFrameMs !== null || window.ropesim.error)"
+
+
+def wait_for(page_or_frame, expression: str, timeout: float = 10.0):
+    """Poll ``expression`` in a page or frame until it is truthy, and return its value."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = page_or_frame.evaluate(expression)
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"{expression!r} still false after {timeout:g} s")
+        time.sleep(0.02)
 
 
 def chromium() -> str | None:
@@ -51,6 +63,11 @@ class Opened:
     requests: list[str] = field(default_factory=list)
     errors: list[str] = field(default_factory=list)
 
+    def wait_for(self, expression: str, timeout: float = 10.0, frame=None):
+        """Poll ``expression`` until it is truthy (Playwright's own wait_for_function evaluates a string, which
+        the page's Content-Security-Policy forbids); TimeoutError after ``timeout`` seconds."""
+        return wait_for(frame or self.page, expression, timeout)
+
     def state(self) -> dict:
         return self.page.evaluate("window.ropesim.state()")
 
@@ -67,16 +84,19 @@ class Browser:
     def __init__(self, context):
         self.context = context
 
-    def open(self, path: str | Path, viewport: tuple[int, int] = (1000, 700)) -> Opened:
+    def open(self, path: str | Path, viewport: tuple[int, int] = (1000, 700), wait: bool = True,
+             allow: tuple[Path, ...] = ()) -> Opened:
+        """Load the page at ``path``; with ``wait``, until its first frame is drawn (or it reported an error).
+        ``allow``: local files the page may load besides itself (the docs' pages share one three.min.js)."""
         path = Path(path).resolve()
         page = self.context.new_page()
         page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
         opened = Opened(page)
-        own = path.as_uri()
+        own = {path.as_uri(), *(Path(a).resolve().as_uri() for a in allow)}
 
         def route(r):
             url = r.request.url
-            if url == own or url.startswith(("data:", "blob:")):
+            if url in own or url.startswith(("data:", "blob:")):
                 r.continue_()
             else:
                 opened.requests.append(url)
@@ -85,9 +105,10 @@ class Browser:
         page.route("**/*", route)
         page.on("console", lambda m: opened.errors.append(m.text) if m.type == "error" else None)
         page.on("pageerror", lambda e: opened.errors.append(str(e)))
-        page.goto(own)
-        page.wait_for_function("window.ropesim && (window.ropesim.firstFrameMs !== null || window.ropesim.error)",
-                               timeout=READY_TIMEOUT_MS)
+        page.goto(path.as_uri())
+        if not wait:
+            return opened
+        opened.wait_for(READY, READY_TIMEOUT)
         error = page.evaluate("window.ropesim.error")
         if error:
             opened.errors.append(error)

@@ -110,6 +110,13 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
     return u ? `${text} ${u}` : text;
   }
 
+  /** A unit for values up to ``largest``: N as kN or MN where that reads better; (factor, unit). */
+  function scaled(unit, largest) {
+    if (unit === "N" && largest >= 1e6) return [1e-6, "MN"];
+    if (unit === "N" && largest >= 1e4) return [1e-3, "kN"];
+    return [1, unit];
+  }
+
   function lastAtOrBefore(times, t) {          // index of the last time <= t (0 if none)
     let lo = 0, hi = times.length - 1;
     if (t <= times[0]) return 0;
@@ -133,10 +140,12 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
       this.playing = false;
       this.speed = 1;
       this.colorBy = this.runs.length > 1 ? "run" : (this.fieldNames()[0] || "run");
-      this.follow = false;
       this.needsRender = true;
       this.tmp = [0, 0, 0];
       this.extent = this.sceneExtent();
+      this.relative = this.followedExtent();
+      // a towed line that travels far beyond its own size is seen from its driven node, as `ropesim frames --follow`
+      this.follow = !!this.relative && this.extent.size > 4 * this.relative.size;
       this.setUpRenderer();
       this.setUpScene();
       this.setUpControls();
@@ -179,6 +188,38 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
       }
       const size = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-3);
       return { lo, hi, size, center: [0, 1, 2].map((c) => (lo[c] + hi[c]) / 2) };
+    }
+
+    /** The first run's driven nodes (line 0), the followed point: their centre at frame f, or null. */
+    drivenCentre(run, f) {
+      const p = run.points.find((pp) => pp.kind === "driven" && pp.line !== undefined);
+      if (!p) return null;
+      const line = run.lines[p.line], c = [0, 0, 0], tmp = [0, 0, 0];
+      for (const k of p.nodes) {
+        const r = nodePosition(run, line.positions, line.nodes, f, k, tmp);
+        if (!r) return null;
+        for (let i = 0; i < 3; i++) c[i] += r[i] / p.nodes.length;
+      }
+      return c;
+    }
+
+    /** The box of the first followable run's lines seen from its driven nodes, over all frames, or null. */
+    followedExtent() {
+      const run = this.runs.find((r) => this.drivenCentre(r, 0));
+      if (!run) return null;
+      const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity], tmp = [0, 0, 0];
+      for (let f = 0; f < run.frames; f++) {
+        const c = this.drivenCentre(run, f);
+        if (!c) continue;
+        for (const line of run.lines) for (let k = 0; k < line.nodes; k++) {
+          const p = nodePosition(run, line.positions, line.nodes, f, k, tmp);
+          if (!p) continue;
+          for (let i = 0; i < 3; i++) { lo[i] = Math.min(lo[i], p[i] - c[i]); hi[i] = Math.max(hi[i], p[i] - c[i]); }
+        }
+      }
+      if (!(lo[0] <= hi[0])) return null;
+      const size = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-3);
+      return { lo, hi, size, center: [0, 1, 2].map((i) => (lo[i] + hi[i]) / 2), run };
     }
 
     /** The box of every line's finite nodes over all frames (scanned once from the integers). */
@@ -242,15 +283,27 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
       for (const m of this.lineMaterials || []) m.resolution.set(w, h);
       if (this.dimension === 2) this.fitOrthographic(false);
       else { this.camera.aspect = w / h; this.camera.updateProjectionMatrix(); }
+      if (this.controls && !this.moved) this.resetView();       // the first view fits whatever the page's size
       this.drawSeries();
       this.requestRender();
+    }
+
+    /** What the first view frames: the whole run, or (following) the line around its driven nodes now. */
+    framed() {
+      if (this.follow && this.relative) {
+        const c = this.drivenCentre(this.relative.run, this.frameOf(this.relative.run)) || [0, 0, 0];
+        const r = this.relative;
+        return { lo: r.lo.map((v, i) => v + c[i]), hi: r.hi.map((v, i) => v + c[i]), size: r.size,
+                 center: r.center.map((v, i) => v + c[i]) };
+      }
+      return this.extent;
     }
 
     fitOrthographic(reset) {
       const cam = this.camera, aspect = this.width / this.height;
       if (reset || this.halfHeight === undefined) {
-        const e = this.extent;
-        const w = (e.hi[0] - e.lo[0]) * 1.1 || 1, h = (e.hi[1] - e.lo[1]) * 1.1 || 1;
+        const e = this.framed();
+        const w = (e.hi[0] - e.lo[0]) * 1.25 || 1, h = (e.hi[1] - e.lo[1]) * 1.15 || 1;   // room for the legend and the colour bar
         this.halfHeight = Math.max(h, w / aspect) / 2;
       }
       cam.left = -this.halfHeight * aspect; cam.right = this.halfHeight * aspect;
@@ -259,10 +312,10 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
     }
 
     resetView() {
-      const e = this.extent, c = e.center;
+      const e = this.framed(), c = e.center;
       this.controls.target.set(c[0], c[1], c[2]);
       if (this.dimension === 2) {
-        this.camera.position.set(c[0], c[1], c[2] + 2 * e.size);
+        this.camera.position.set(c[0], c[1], c[2] + 2 * this.extent.size);
         this.camera.zoom = 1;
         this.fitOrthographic(true);
       } else {
@@ -272,6 +325,10 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
       }
       this.camera.lookAt(c[0], c[1], c[2]);
       this.controls.update();
+      this.followed = this.follow && this.relative ? this.drivenCentre(this.relative.run, this.frameOf(this.relative.run)) : null;
+      if (this.followed) this.grids.relative.position.set(...this.followed);
+      this.moved = false;
+      this.showGrid();
       this.requestRender();
     }
 
@@ -295,7 +352,12 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
         this.drawn.push(parts);
         parts.run = r;
       }
-      this.scene.add(this.makeGrid());
+      this.grids = { absolute: this.makeGrid(this.extent, false), relative: null };
+      this.scene.add(this.grids.absolute);
+      if (this.relative) {
+        this.grids.relative = this.makeGrid(this.relative, true);
+        this.scene.add(this.grids.relative);
+      }
       this.makeTriad();
     }
 
@@ -487,25 +549,34 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
       water.object.geometry.computeVertexNormals();
     }
 
-    makeGrid() {
-      const e = this.extent, group = new THREE.Group();
+    /** A grid under the run (3-D: at its lowest point; 2-D: behind it) over the box ``e``; ``relative``: a
+     * grid around the driven node that moves with it. */
+    makeGrid(e, relative) {
+      const group = new THREE.Group();
       const step = niceStep(e.size, 8);
-      this.gridStep = step;
       const material = new THREE.LineBasicMaterial({ color: 0xc9ced6 });
       const pts = [];
       const bAxis = this.dimension === 2 ? 1 : 2;
       const pad = this.dimension === 2 ? 2 * e.size : 0;   // a flat view pans and zooms out over more of it
       const a0 = Math.floor((e.lo[0] - pad) / step) * step, a1 = Math.ceil((e.hi[0] + pad) / step) * step;
       const b0 = Math.floor((e.lo[bAxis] - pad) / step) * step, b1 = Math.ceil((e.hi[bAxis] + pad) / step) * step;
-      const at = (a, b) => (this.dimension === 2 ? new THREE.Vector3(a, b, -3e-3 * e.size)
+      const at = (a, b) => (this.dimension === 2 ? new THREE.Vector3(a, b, -3e-3 * this.extent.size)
                                                  : new THREE.Vector3(a, e.lo[1], b));
       for (let a = a0; a <= a1 + step / 2; a += step) pts.push(at(a, b0), at(a, b1));
       for (let b = b0; b <= b1 + step / 2; b += step) pts.push(at(a0, b), at(a1, b));
       const grid = new THREE.LineSegments(new THREE.BufferGeometry().setFromPoints(pts), material);
       grid.renderOrder = -1;
       group.add(grid);
-      $("grid-note").textContent = `grid ${format(step, "m")}` + (this.dimension === 3 ? " (at the lowest point)" : "");
+      group.userData.note = `grid ${format(step, "m")}` + (relative ? ", moving with the driven node"
+        : this.dimension === 3 ? " (at the lowest point)" : "");
       return group;
+    }
+
+    showGrid() {
+      const following = this.follow && !!this.grids.relative;
+      this.grids.absolute.visible = !following;
+      if (this.grids.relative) this.grids.relative.visible = following;
+      $("grid-note").textContent = (following ? this.grids.relative : this.grids.absolute).userData.note;
     }
 
     makeTriad() {
@@ -543,6 +614,7 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
         controls.touches = { ONE: THREE.TOUCH.PAN, TWO: THREE.TOUCH.DOLLY_PAN };
       }
       controls.addEventListener("change", () => this.requestRender());
+      controls.addEventListener("start", () => { this.moved = true; });
       this.controls = controls;
       this.resize();
       this.resetView();
@@ -578,9 +650,9 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
       colorBy.value = this.colorBy;
       colorBy.addEventListener("change", () => { this.colorBy = colorBy.value; this.showFrame(this.index); });
 
-      const followable = this.runs.some((r) => r.points.some((p) => p.kind === "driven"));
-      $("follow-box").hidden = !followable;
-      $("follow").addEventListener("change", (ev) => { this.follow = ev.target.checked; this.followed = null; this.showFrame(this.index); });
+      $("follow-box").hidden = !this.relative;
+      $("follow").checked = this.follow;
+      $("follow").addEventListener("change", (ev) => { this.follow = ev.target.checked; this.resetView(); });
 
       document.addEventListener("keydown", (ev) => {
         if (ev.target instanceof HTMLSelectElement || ev.ctrlKey || ev.metaKey || ev.altKey) return;
@@ -699,7 +771,7 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
         for (const b of parts.bodies) this.poseBody(run, b.b, b.object, f);
         if (parts.water) this.moveWater(parts.water, f);
       }
-      if (this.follow) this.followDriven();
+      if (this.follow && this.relative) this.followDriven();
       this.updateColorbar();
       this.drawSeries();
       this.requestRender();
@@ -711,20 +783,17 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
     }
 
     followDriven() {
-      const parts = this.drawn.find((d) => this.runs[d.run].points.some((p) => p.kind === "driven"));
-      if (!parts) return;
-      const p = parts.points.find((pp) => pp.p.kind === "driven");
-      const a = p.positions, n = p.count;
-      const centre = new THREE.Vector3();
-      for (let k = 0; k < n; k++) centre.add(new THREE.Vector3(a[3 * k], a[3 * k + 1], a[3 * k + 2]));
-      centre.divideScalar(n);
+      const c = this.drivenCentre(this.relative.run, this.frameOf(this.relative.run));
+      if (!c) return;
+      const centre = new THREE.Vector3(...c);
       if (this.followed) {
-        const shift = centre.clone().sub(this.followed);
+        const shift = centre.clone().sub(new THREE.Vector3(...this.followed));
         this.camera.position.add(shift);
         this.controls.target.add(shift);
         this.controls.update();
       }
-      this.followed = centre;
+      this.followed = c;
+      this.grids.relative.position.copy(centre);
     }
 
     fieldOf(line) { return line.fields.find((f) => f.name === this.colorBy); }
@@ -884,17 +953,18 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
       const Y = (v) => box.top + (1 - (v - lo) / (hi - lo)) * box.height;
       g.font = "11px system-ui, sans-serif";
       g.fillStyle = "#444"; g.strokeStyle = "#ddd"; g.lineWidth = 1;
-      const vs = niceStep(hi - lo, 4);
+      const [factor, shownUnit] = scaled(this.seriesUnit, Math.max(Math.abs(lo), Math.abs(hi)));
+      const vs = niceStep((hi - lo) * factor, 4) / factor;
       g.textAlign = "right"; g.textBaseline = "middle";
       for (let v = Math.ceil(lo / vs) * vs; v <= hi + vs / 1e6; v += vs) {
         g.beginPath(); g.moveTo(box.left, Y(v)); g.lineTo(box.left + box.width, Y(v)); g.stroke();
-        g.fillText(format(v, this.seriesUnit === "N" ? "" : ""), box.left - 4, Y(v));
+        g.fillText(format(v * factor, ""), box.left - 4, Y(v));
       }
       const ts = niceStep(t1 - t0, 8);
       g.textAlign = "center"; g.textBaseline = "top";
       for (let t = Math.ceil(t0 / ts) * ts; t <= t1 + ts / 1e6; t += ts) g.fillText(format(t, ""), X(t), box.top + box.height + 4);
       g.textAlign = "left"; g.textBaseline = "top";
-      g.fillText(`[${this.seriesUnit}]`, 4, 4);
+      g.fillText(`[${shownUnit}]`, 4, 4);
       g.textAlign = "right";
       g.fillText("t [s]", w - 4, h - 14);
       let legendX = box.left;
