@@ -38,6 +38,31 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
     return new Uint8Array(await new Response(stream).arrayBuffer());
   }
 
+  // A ribbon's vertex: at ``position``, the other end of its segment at ``other``; pushed ``side`` (+1 or -1)
+  // half a width across the segment as the screen shows it, and half a width out beyond its own end.
+  const RIBBON_VERTEX = `
+    uniform vec2 resolution;
+    uniform float width;
+    attribute vec3 other;
+    attribute float side;
+    varying vec3 vColor;
+    void main() {
+      vColor = color;
+      vec4 here = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
+      vec4 there = projectionMatrix * modelViewMatrix * vec4(other, 1.0);
+      vec2 a = here.xy / here.w * resolution, b = there.xy / there.w * resolution;
+      vec2 along = b - a;
+      float len = length(along);
+      along = len > 1e-6 ? along / len : vec2(1.0, 0.0);
+      vec2 across = vec2(-along.y, along.x);
+      vec2 shift = (side * across - along) * width / resolution;   // [clip units]: pixels * 2 / size, halved
+      gl_Position = here;
+      gl_Position.xy += shift * here.w;
+    }`;
+  const RIBBON_FRAGMENT = `
+    varying vec3 vColor;
+    void main() { gl_FragColor = vec4(vColor, 1.0); }`;
+
   const TYPES = { u16: Uint16Array, u8: Uint8Array, f32: Float32Array, f64: Float64Array };
 
   /** The array a reference names, decoded in place: "delta-along" adds back the differences along the last
@@ -117,6 +142,10 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
     return [1, unit];
   }
 
+  function srgb(hex) {
+    return [1, 3, 5].map((i) => parseInt(hex.substr(i, 2), 16) / 255);
+  }
+
   function lastAtOrBefore(times, t) {          // index of the last time <= t (0 if none)
     let lo = 0, hi = times.length - 1;
     if (t <= times[0]) return 0;
@@ -125,6 +154,14 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
       if (times[mid] <= t * (1 + 1e-12) + 1e-12) lo = mid; else hi = mid - 1;
     }
     return lo;
+  }
+
+  /** True when WebGL is drawn by the CPU (SwiftShader, llvmpipe): no graphics card to lean on. */
+  function softwareWebGL() {
+    const gl = document.createElement("canvas").getContext("webgl");
+    const info = gl && gl.getExtension("WEBGL_debug_renderer_info");
+    const name = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : "";
+    return /swiftshader|llvmpipe|software/i.test(name);
   }
 
   // -------------------------------------------------------------------------------------- the viewer
@@ -255,7 +292,8 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
 
     setUpRenderer() {
       const host = $("view");
-      this.renderer = new THREE.WebGLRenderer({ antialias: true });
+      // multisampling is nearly free on a graphics card and costs a quarter of the frame rate in software WebGL
+      this.renderer = new THREE.WebGLRenderer({ antialias: !softwareWebGL() });
       this.renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
       this.renderer.setClearColor(BACKGROUND);
       this.renderer.autoClear = false;
@@ -280,7 +318,7 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
       const w = Math.max(host.clientWidth, 1), h = Math.max(host.clientHeight, 1);
       this.renderer.setSize(w, h);
       this.width = w; this.height = h;
-      for (const m of this.lineMaterials || []) m.resolution.set(w, h);
+      for (const m of this.lineMaterials || []) m.uniforms.resolution.value.set(w, h);
       if (this.dimension === 2) this.fitOrthographic(false);
       else { this.camera.aspect = w / h; this.camera.updateProjectionMatrix(); }
       if (this.controls && !this.moved) this.resetView();       // the first view fits whatever the page's size
@@ -361,19 +399,40 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
       this.makeTriad();
     }
 
+    /** A line as a ribbon LINE_WIDTH pixels wide: a quad per segment, widened on the screen by the vertex
+     * shader, each end pushed out by half the width so that neighbours overlap at the joints. (three.js's own
+     * fat lines draw each segment as an instance, which software WebGL (SwiftShader) draws one by one: a 2000-node
+     * line took 35 ms a frame, this one a few.) */
     makeLine(run, line) {
-      const segments = line.closed ? line.nodes : line.nodes - 1;
-      const geometry = new THREE.LineSegmentsGeometry();
-      const positions = new Float32Array(6 * Math.max(segments, 1));
-      const colors = new Float32Array(6 * Math.max(segments, 1));
-      geometry.setPositions(positions);
-      geometry.setColors(colors);
-      const material = new THREE.LineMaterial({ linewidth: LINE_WIDTH, vertexColors: true, worldUnits: false });
+      const segments = Math.max(line.closed ? line.nodes : line.nodes - 1, 1);
+      const geometry = new THREE.BufferGeometry();
+      const attribute = (size, dynamic) => {
+        const a = new THREE.BufferAttribute(new Float32Array(4 * segments * size), size);
+        if (dynamic) a.setUsage(THREE.DynamicDrawUsage);
+        return a;
+      };
+      geometry.setAttribute("position", attribute(3, true));
+      geometry.setAttribute("other", attribute(3, true));
+      geometry.setAttribute("color", attribute(3, true));
+      const side = attribute(1, false), index = new Uint32Array(6 * segments);
+      for (let s = 0; s < segments; s++) {
+        side.array.set([1, -1, -1, 1], 4 * s);          // the far end's normal is turned round: -1 is its +1
+        const v = 4 * s;
+        index.set([v, v + 1, v + 2, v + 2, v + 1, v + 3], 6 * s);
+      }
+      geometry.setAttribute("side", side);
+      geometry.setIndex(new THREE.BufferAttribute(index, 1));
+      const material = new THREE.ShaderMaterial({
+        uniforms: { resolution: { value: new THREE.Vector2(1, 1) }, width: { value: LINE_WIDTH } },
+        vertexShader: RIBBON_VERTEX, fragmentShader: RIBBON_FRAGMENT, side: THREE.DoubleSide, vertexColors: true,
+      });
       this.lineMaterials.push(material);
-      const object = new THREE.LineSegments2(geometry, material);
+      const object = new THREE.Mesh(geometry, material);
       object.frustumCulled = false;
       object.renderOrder = 2;
-      return { object, line, segments, positions, colors, geometry };
+      return { object, line, segments: line.closed ? line.nodes : line.nodes - 1, geometry,
+               positions: geometry.attributes.position.array, others: geometry.attributes.other.array,
+               colors: geometry.attributes.color.array };
     }
 
     glyph(kind) {
@@ -799,9 +858,9 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
     fieldOf(line) { return line.fields.find((f) => f.name === this.colorBy); }
 
     updateLine(run, l, f) {
-      const line = l.line, n = line.nodes, pos = l.positions, col = l.colors;
+      const line = l.line, n = line.nodes, pos = l.positions, other = l.others, col = l.colors;
       const field = this.colorBy === "run" ? null : this.fieldOf(line);
-      const runColor = new THREE.Color(run.color);
+      const runColor = srgb(run.color);      // the ribbon writes its colours as they are: sRGB
       const p = [0, 0, 0], q = [0, 0, 0];
       const cmap = this.colormap;
       const colorOf = (level, out, o) => {
@@ -809,31 +868,33 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
         const k = 3 * Math.round((level * 255) / FIELD_LEVELS);
         out[o] = cmap[k]; out[o + 1] = cmap[k + 1]; out[o + 2] = cmap[k + 2];
       };
+      const c = [0, 0, 0, 0, 0, 0];
       for (let s = 0; s < l.segments; s++) {
         const a = s, b = (s + 1) % n;
-        const pa = nodePosition(run, line.positions, n, f, a, p), pb = nodePosition(run, line.positions, n, f, b, q);
-        const o = 6 * s;
-        if (pa && pb) {
-          pos[o] = pa[0]; pos[o + 1] = pa[1]; pos[o + 2] = pa[2];
-          pos[o + 3] = pb[0]; pos[o + 4] = pb[1]; pos[o + 5] = pb[2];
-        } else {                                    // a node that is not finite: a segment of no length
-          const keep = pa || pb || [0, 0, 0];
-          pos[o] = pos[o + 3] = keep[0]; pos[o + 1] = pos[o + 4] = keep[1]; pos[o + 2] = pos[o + 5] = keep[2];
+        let pa = nodePosition(run, line.positions, n, f, a, p), pb = nodePosition(run, line.positions, n, f, b, q);
+        if (!pa || !pb) pa = pb = pa || pb || [0, 0, 0];    // a node that is not finite: a segment of no length
+        const o = 12 * s;
+        for (let k = 0; k < 3; k++) {
+          pos[o + k] = pos[o + 3 + k] = other[o + 6 + k] = other[o + 9 + k] = pa[k];
+          pos[o + 6 + k] = pos[o + 9 + k] = other[o + k] = other[o + 3 + k] = pb[k];
         }
         if (!field) {
-          col[o] = col[o + 3] = runColor.r; col[o + 1] = col[o + 4] = runColor.g; col[o + 2] = col[o + 5] = runColor.b;
+          c[0] = c[3] = runColor[0]; c[1] = c[4] = runColor[1]; c[2] = c[5] = runColor[2];
         } else if (field.per === "segment") {
           const per = field.values.length / run.frames;
-          colorOf(field.values[f * per + s], col, o);
-          col[o + 3] = col[o]; col[o + 4] = col[o + 1]; col[o + 5] = col[o + 2];
+          colorOf(field.values[f * per + s], c, 0);
+          c[3] = c[0]; c[4] = c[1]; c[5] = c[2];
         } else {
-          colorOf(field.values[f * n + a], col, o);
-          colorOf(field.values[f * n + b], col, o + 3);
+          colorOf(field.values[f * n + a], c, 0);
+          colorOf(field.values[f * n + b], c, 3);
+        }
+        for (let k = 0; k < 3; k++) {
+          col[o + k] = col[o + 3 + k] = c[k];
+          col[o + 6 + k] = col[o + 9 + k] = c[3 + k];
         }
       }
-      const g = l.geometry;
-      g.attributes.instanceStart.data.needsUpdate = true;
-      g.attributes.instanceColorStart.data.needsUpdate = true;
+      const attributes = l.geometry.attributes;
+      attributes.position.needsUpdate = attributes.other.needsUpdate = attributes.color.needsUpdate = true;
     }
 
     updatePoints(run, pp, f) {
