@@ -151,10 +151,10 @@ class Trajectory:
         return inline_animation(self, **options)
 
     def view(self, **options):
-        """The run in the browser viewer (`ropesim view`'s page, see :func:`ropesim.viewer.page.make_page` for
-        ``every``, ``start``, ``end``): a notebook shows it in a sandboxed iframe, ``.save(path)`` writes it."""
-        from ..viewer.page import NOTEBOOK_BUDGET, make_page
-        return make_page(self, **{"budget": NOTEBOOK_BUDGET, **options})
+        """This run in the browser viewer (`ropesim view`'s page; options ``every``, ``start``, ``end`` as
+        :func:`ropesim.view`'s): a notebook shows it in a sandboxed iframe, ``.save(path)`` writes it."""
+        from ..viewer.page import view
+        return view(self, **options)
 
     def _repr_html_(self) -> str:
         """In Jupyter: the short summary table, and the run in the viewer below it."""

@@ -154,14 +154,25 @@ class RunContent:
 
 
 class Speed:
-    """Each node's speed |v| (F, N) [m/s], computed from the velocities (F, N, D) when read."""
+    """Each node's speed |v| (F, N) [m/s], computed from the velocities (F, N, D) when read; the blocks read
+    last are kept (the packer reads each block twice: for the range, then to store it)."""
+
+    KEEP_BYTES = 64 * 2 ** 20
 
     def __init__(self, v: FrameArray):
         self.v = v
         self.shape = tuple(v.shape[:2])
+        self._kept: dict[bytes, np.ndarray] = {}
 
     def __getitem__(self, index):
-        return np.linalg.norm(np.asarray(self.v[index], dtype=float), axis=-1)
+        key = np.asarray(index).tobytes() if not isinstance(index, slice) else None
+        if key is not None and key in self._kept:
+            return self._kept[key]
+        v = np.asarray(self.v[index], dtype=float)
+        speed = np.sqrt(np.einsum("...d,...d->...", v, v))
+        if key is not None and speed.nbytes + sum(a.nbytes for a in self._kept.values()) <= self.KEEP_BYTES:
+            self._kept[key] = speed
+        return speed
 
 
 class Scaled:

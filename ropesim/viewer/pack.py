@@ -191,9 +191,13 @@ def _extent(content: RunContent, frames: np.ndarray) -> Extent:
     for array in _moving_positions(content):
         for _, idx in _blocks(frames):
             block = np.asarray(array[idx], dtype=float).reshape(len(idx), -1, d)
-            finite = block[np.isfinite(block).all(axis=-1)]
-            if len(finite):
-                lo, hi = np.minimum(lo, finite.min(axis=0)), np.maximum(hi, finite.max(axis=0))
+            low, high = block.min(axis=(0, 1)), block.max(axis=(0, 1))
+            if not (np.all(np.isfinite(low)) and np.all(np.isfinite(high))):     # a blow-up: the finite ones
+                finite = block[np.isfinite(block).all(axis=-1)]
+                if not len(finite):
+                    continue
+                low, high = finite.min(axis=0), finite.max(axis=0)
+            lo, hi = np.minimum(lo, low), np.maximum(hi, high)
     if not np.all(np.isfinite(lo)):
         raise ViewError(f"{content.name}: no finite position in the frames shown")
     ranges = {}
@@ -202,9 +206,13 @@ def _extent(content: RunContent, frames: np.ndarray) -> Extent:
             low, high = math.inf, -math.inf
             for _, idx in _blocks(frames):
                 block = np.asarray(f.values[idx], dtype=float)
-                finite = block[np.isfinite(block)]
-                if len(finite):
-                    low, high = min(low, float(finite.min())), max(high, float(finite.max()))
+                b_low, b_high = float(block.min()), float(block.max())
+                if not (math.isfinite(b_low) and math.isfinite(b_high)):
+                    finite = block[np.isfinite(block)]
+                    if not len(finite):
+                        continue
+                    b_low, b_high = float(finite.min()), float(finite.max())
+                low, high = min(low, b_low), max(high, b_high)
             ranges[(i, f.name)] = (low, high) if low <= high else (0.0, 0.0)
     return Extent(origin=lo, size=float(np.max(hi - lo)), ranges=ranges)
 

@@ -102,6 +102,18 @@ def make_page(runs, *, every: int | None = None, start: float | None = None, end
                 every=selection.every, note=selection.note)
 
 
+def view(runs, *, every: int | None = None, start: float | None = None, end: float | None = None,
+         budget: int = NOTEBOOK_BUDGET) -> Page:
+    """Runs in the browser viewer, as `ropesim view` shows them: ``runs`` are run folders or
+    :class:`ropesim.Trajectory` objects (several are overlaid, each in its own colour). A notebook shows the
+    returned :class:`Page` in a sandboxed iframe; ``page.save("runs.html")`` writes it as one offline file.
+
+    Every saved frame from ``start`` to ``end`` [s] is kept, or every ``every``-th; without ``every`` a page
+    that would pass ``budget`` bytes (20 MB: a notebook keeps its outputs) is thinned in time, and
+    ``page.note`` says so. Positions are within max(0.1 mm, 1e-5 of the run's size) of the saved ones."""
+    return make_page(runs, every=every, start=start, end=end, budget=budget)
+
+
 def _fixed_parts(three: str | None) -> dict[str, str]:
     if three is None:
         script = f"<script>{asset('three.min.js')}</script>"
