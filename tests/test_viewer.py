@@ -276,6 +276,10 @@ def test_several_runs_overlay_into_the_first_folder(shooter, tmp_path):
     description, _ = page_data((shooter.folder / "overlay.html").read_text())
     assert [(r["name"], r["frames"], r["color"]) for r in description["runs"]] == [
         ("shooter_medium", 31, "#1f77b4"), ("shooter_high", 21, "#2ca02c")]
+    ranges = [[(f["name"], f["low"], f["high"]) for f in r["lines"][0]["fields"]] for r in description["runs"]]
+    assert ranges[0] == ranges[1]                    # one colour scale for both runs: their colours compare
+    tension = np.concatenate([np.ravel(shooter.tension), np.ravel(other.tension)])
+    assert ranges[0][0][1:] == pytest.approx((tension.min(), tension.max()))
 
 
 def test_an_interrupted_run_is_viewed_from_its_checkpoint(tmp_path):

@@ -199,3 +199,21 @@ def test_a_notebook_iframe_runs_the_viewer(browser, builtin_runs, tmp_path):
     opened.wait_for("window.ropesim && window.ropesim.firstFrameMs !== null", 30, frame=frame)
     assert frame.evaluate("window.ropesim.info()")[0]["name"] == "helicopter_mass"
     assert_clean(opened)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", builtin_names())
+def test_every_built_in_scene_at_its_full_length(browser, name, tmp_path):
+    """The gallery's runs, whole: the page opens offline without an error, and the last frame's positions are
+    the run's within the bound."""
+    traj = ropesim.simulate(ropesim.load_scene(name), tmp_path / name)
+    write_page(traj.folder, tmp_path / "view.html")
+    opened = browser.open(tmp_path / "view.html")
+    assert_clean(opened)
+    (info,) = opened.info()
+    assert info["frames"] == traj.frames
+    opened.page.keyboard.press("End")
+    shown = np.array(opened.page.evaluate("window.ropesim.positions(0, 0)"), dtype=float)
+    assert np.abs(shown - np.asarray(traj.x[-1])).max() <= info["bound"] * (1 + 1e-6)
+    assert drawn_fraction(picture(opened.canvas_png())) > 0.003
+    opened.page.close()

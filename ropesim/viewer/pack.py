@@ -6,7 +6,8 @@ position the page shows); as 16-bit integers from the box's corner (the size is 
 they fit; 65535 marks a coordinate that is not finite). Then they are delta-coded: each frame minus the frame
 before it, and that difference minus the one of the node before it along the line, modulo 2^16 (a smooth
 motion leaves mostly small numbers; decoding adds them back exactly, with no drift). **Fields** to colour by
-(tension, strain, speed) are stored to 1/254 of their range over the run (8 bits: the colour map has 256
+(tension, strain, speed) are stored to 1/254 of their range over the runs shown (one range for every run, so
+that their colours compare) (8 bits: the colour map has 256
 colours), delta-coded along the line; 255 marks a value that is not finite. **Times and series** are stored as
 float64 and float32. Rigid bodies' poses are float32 (1e-7 relative: far below a pixel).
 
@@ -290,18 +291,26 @@ def pack(contents: list[RunContent], selection: Selection, colormap: bytes) -> t
     """The page's description (JSON-ready) and its compressed data for ``contents`` at ``selection``'s frames;
     ``colormap``: 256 RGB triplets, the colours of a field from its low to its high end."""
     buffer = Buffer()
-    runs = [_pack_run(c, frames, buffer, RUN_COLORS[i % len(RUN_COLORS)])
-            for i, (c, frames) in enumerate(zip(contents, selection.frames))]
+    for c, frames in zip(contents, selection.frames):
+        if not len(frames):
+            raise ViewError(f"{c.name}: no frame in the time range shown")
+    extents = [_extent(c, frames) for c, frames in zip(contents, selection.frames)]
+    shared: dict[str, tuple[float, float]] = {}     # a field has one range over every run: colours compare
+    for extent in extents:
+        for (_, name), (low, high) in extent.ranges.items():
+            old = shared.get(name, (math.inf, -math.inf))
+            shared[name] = (min(old[0], low), max(old[1], high))
+    for extent in extents:
+        extent.ranges = {(i, name): shared[name] for (i, name) in extent.ranges}
+    runs = [_pack_run(c, frames, extent, buffer, RUN_COLORS[i % len(RUN_COLORS)])
+            for i, (c, frames, extent) in enumerate(zip(contents, selection.frames, extents))]
     description = {"format": FORMAT, "runs": runs, "colormap": colormap.hex(), "note": selection.note,
                    "every": selection.every, "bytes": buffer.size}
     return description, buffer.compressed()
 
 
-def _pack_run(content: RunContent, frames: np.ndarray, buffer: Buffer, color: str) -> dict:
+def _pack_run(content: RunContent, frames: np.ndarray, extent: Extent, buffer: Buffer, color: str) -> dict:
     d = content.dimension
-    if not len(frames):
-        raise ViewError(f"{content.name}: no frame in the time range shown")
-    extent = _extent(content, frames)
     lines = []
     for i, line in enumerate(content.lines):
         fields = []

@@ -21,6 +21,7 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
   const hook = { renders: 0, firstFrameMs: null, decodeMs: null, error: null };
   let resolveReady, rejectReady;
   hook.ready = new Promise((res, rej) => { resolveReady = res; rejectReady = rej; });
+  hook.ready.catch(() => {});      // a failure is shown in the page and logged once (fail), not again unhandled
   window.ropesim = hook;
 
   // ------------------------------------------------------------------------------------------- data
@@ -925,9 +926,7 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
       this.colorbarFor = this.colorBy;
       const { low, high, unit } = this.fieldRange();
       bar.hidden = false;
-      // each run's field is quantised over its own range; with several runs the bar shows the first run's
-      const first = this.runs.map((r) => r.lines.map((l) => this.fieldOf(l)).find(Boolean)).find(Boolean);
-      const lo = first ? first.low : low, hi = first ? first.high : high;
+      const lo = low, hi = high;              // one range for every run (the packer makes it so)
       $("colorbar-title").textContent = `${this.colorBy} [${unit || "–"}]`;
       const canvas = $("colorbar-canvas"), g = canvas.getContext("2d");
       const h = canvas.height;
@@ -945,8 +944,6 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
         div.textContent = format(v, unit);
         ticks.appendChild(div);
       }
-      bar.title = this.runs.length > 1 && (lo !== low || hi !== high)
-        ? `each run is coloured over its own range; this bar is ${this.runs[0].name}'s` : "";
     }
 
     setUpPanel() {
