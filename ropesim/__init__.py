@@ -5,6 +5,7 @@
     traj = ropesim.simulate(scene)            # in memory; or simulate(scene, "runs/x") to write a run folder
     traj.x[-1]                                # final positions, (N, D) [m]
     ropesim.Trajectory.open("runs/x")         # read a run folder lazily
+    ropesim.view(["runs/a", "runs/b"]).save("ab.html")   # the runs overlaid in the browser viewer
 
 Heavy modules (numba, matplotlib) load only when first used, so the command line starts fast.
 """
@@ -21,7 +22,7 @@ from .io.numba_cache import ensure_writable_cache  # noqa: E402
 ensure_writable_cache()  # before any kernel is defined: a read-only install caches its kernels elsewhere
 
 __all__ = ["load_scene", "scene_from_toml", "SceneError", "Scene", "simulate", "Trajectory", "RunFolderError",
-           "METHODS", "scene_to_toml"]
+           "METHODS", "scene_to_toml", "view"]
 
 _LAZY = {
     "load_scene": "scene.loader", "scene_from_toml": "scene.loader", "SceneError": "scene.loader",
@@ -29,6 +30,7 @@ _LAZY = {
     "simulate": "run",
     "Trajectory": "io.trajectory", "RunFolderError": "io.trajectory",
     "METHODS": "integrate.methods",
+    "view": "viewer.page",
 }
 
 

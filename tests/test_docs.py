@@ -377,7 +377,7 @@ def _workspace(tmp_path: Path, capped: bool) -> dict:
         shim.chmod(0o755)
         path.insert(0, str(shim_dir))
     env = {**os.environ, "PATH": os.pathsep.join(path + [os.environ.get("PATH", "")]), "MPLBACKEND": "Agg",
-           "PYTHONUNBUFFERED": "1"}
+           "PYTHONUNBUFFERED": "1", "BROWSER": "true"}   # `ropesim view` opens its page with `true`: nothing
     return env
 
 

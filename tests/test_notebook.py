@@ -64,6 +64,9 @@ def test_the_notebooks_run_without_an_error_or_a_warning(path, tmp_path):
     if path.name == "quickstart.ipynb":
         assert any("ropesim.Trajectory" in h and "helicopter_mass" in h for h in html)
         assert any(h.startswith("<video") for h in html)
+        viewers = [h for h in html if '<iframe sandbox="allow-scripts" srcdoc=' in h]   # the browser viewer
+        assert len(viewers) == 2 and all("ropesim-data" in h for h in viewers)
+        assert (tmp_path / "helicopter_mass.html").is_file()
 
 
 def test_there_is_a_notebook():

@@ -39,6 +39,7 @@ COMMANDS = {
     "plot": (["plot", "RUN", "--out", "OUT", "-q"], "file.png"),
     "animate": (["animate", "RUN", "--out", "OUT", "--end", "0.05", "--size", "320", "-q"], "file.gif"),
     "new": (["new", "OUT"], "file.toml"),
+    "view": (["view", "RUN", "--out", "OUT", "--no-open"], "file.html"),
     "equilibrium": (["equilibrium", "cantilever_beam", "--out", "OUT"], "file.toml"),
     "accuracy": (["accuracy", str(SCENE), *QUICK, "--methods", "symplectic_euler", "--dts", "0.01",
                   "--repeats", "1", "--out", "OUT"], "folder"),
@@ -61,7 +62,7 @@ def _user_files(folder: Path) -> None:
     (folder / "sub").mkdir(parents=True, exist_ok=True)
     (folder / "notes.txt").write_text("the user's notes")
     (folder / "sub" / "data.bin").write_bytes(bytes(range(256)))
-    for name in ("x.csv", "x.png", "x.gif", "x.toml", "results.csv", "accuracy.csv", "stability.png"):
+    for name in ("x.csv", "x.png", "x.gif", "x.toml", "x.html", "results.csv", "accuracy.csv", "stability.png"):
         (folder / name).write_bytes(b"the user's " + name.encode())
 
 
@@ -104,7 +105,7 @@ def test_no_writing_command_changes_a_file_ropesim_did_not_write(source_run, com
         user = snapshot(work)                     # everything here now is the user's (the run copy too: as made)
         if state.startswith("run folder"):
             user = {k: v for k, v in user.items() if not k.startswith("out/") or k.split("/")[1] in (
-                "notes.txt", "sub", "x.csv", "x.png", "x.gif", "x.toml", "results.csv", "accuracy.csv",
+                "notes.txt", "sub", "x.csv", "x.png", "x.gif", "x.toml", "x.html", "results.csv", "accuracy.csv",
                 "stability.png")}
         line = [a.replace("RUN", str(source_run)).replace("OUT", str(target)) for a in args]
         result = CliRunner().invoke(app, line)

@@ -854,6 +854,80 @@ def plot(
 
 
 @app.command(cls=Command, rich_help_panel=PICTURES)
+def view(
+    run_dirs: Annotated[list[Path], typer.Argument(
+        metavar="RUN_DIR...", help="Run folders written by `ropesim run` (finished, interrupted or still "
+                                   "running); several are overlaid in one view, each in its own colour.",
+        show_default=False)],
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", "-o", help="Output HTML file (default RUN_DIR/view.html; for several runs the first one's "
+                            "overlay.html). A file ropesim did not write is never replaced.",
+        show_default=False)] = None,
+    every: Annotated[Optional[int], typer.Option(
+        "--every", metavar="N", callback=_bounded("--every", 1, 10 ** 9, "a number of saved frames"),
+        help="Keep one saved frame in N (default: every frame, or as few as keep the page under 50 MB, "
+             "with a message saying so).", show_default=False)] = None,
+    start: Annotated[Optional[float], typer.Option("--from", "--start", metavar="T",
+                                                   help="First time shown, in seconds (default: the start).",
+                                                   show_default=False)] = None,
+    end: Annotated[Optional[float], typer.Option("--to", "--end", metavar="T",
+                                                 help="Last time shown, in seconds (default: the end).",
+                                                 show_default=False)] = None,
+    no_open: Annotated[bool, typer.Option("--no-open", help="Write the page without opening it in a browser.")]
+        = False,
+    quiet: QuietOpt = False,
+) -> None:
+    """See runs in the browser: one self-contained HTML page with an interactive 3-D viewer, offline.
+
+    The page plays the run (space; arrows step a frame), turns, zooms and pans the view (a 2-D scene is shown
+    flat), colours the line by tension, strain or speed with a colour bar in the run's units, marks the supports,
+    driven nodes, bodies, the thrower box and guide circles as `ropesim animate` does, and shows the end
+    tensions (or the shooter's loop inclination) over time beside the run's summary. It needs no network and no
+    server: mail it, or drop it into a report folder. Positions are stored within 0.1 mm or 1e-5 of the scene's
+    size, whichever is larger. It opens in the default browser where there is one.
+    """
+    from ..viewer import ViewError
+    from ..viewer.page import check_target, write_page
+
+    runs = [_open_run(run_dir, "view") for run_dir in run_dirs]
+    target = out if out is not None else run_dirs[0] / ("view.html" if len(run_dirs) == 1 else "overlay.html")
+    try:
+        check_target(target, "--out" if out is not None else None)
+    except ViewError as exc:
+        fail(str(exc))
+    try:
+        page = _picture(lambda: write_page(runs, target, "--out" if out is not None else None, every=every,
+                                           start=start, end=end))
+    except ViewError as exc:
+        fail(str(exc))
+    if page.note and not quiet:
+        typer.echo(f"ropesim: {target}: {page.note}", err=True)
+    if not quiet:
+        shown = ", ".join(f"{name} ({frames:,} frames)" for name, frames in zip(page.runs, page.frames))
+        typer.echo(f"{target}: {shown}, {page.nbytes / 1e6:.1f} MB")
+    if not no_open:
+        said = _open_in_browser(target)
+        if said and not quiet:
+            typer.echo(said, err=True)
+
+
+def _open_in_browser(path: Path) -> str | None:
+    """Open ``path`` in the default browser where there is one (a desktop session: never a text browser in the
+    terminal); None when it opened, else a line saying why not."""
+    import os
+    import webbrowser
+
+    if sys.platform.startswith(("linux", "freebsd", "openbsd")) and not (os.environ.get("DISPLAY")
+                                                                       or os.environ.get("WAYLAND_DISPLAY")):
+        return f"ropesim: no display here to open a browser on; open {path} in one"
+    try:
+        opened = webbrowser.open(path.resolve().as_uri())
+    except webbrowser.Error:
+        opened = False
+    return None if opened else f"ropesim: found no browser to open; open {path} in one"
+
+
+@app.command(cls=Command, rich_help_panel=PICTURES)
 def export(
     run_dir: RunDirArg,
     to: Annotated[str, typer.Option("--to", "-t", metavar="[vtk|csv]", autocompletion=_formats,

@@ -75,13 +75,24 @@ def print_summary(summary: dict, folder: Path) -> None:
     table = Table(title=f"{summary['scene']}: {summary['status']}", show_header=False, title_justify="left")
     table.add_column("", style="bold")
     table.add_column("", overflow="fold")  # words wrap; a word too long for the column folds, never cut
-    rows = [
-        ("simulated", f"t = 0 .. {summary['t_end']:.6g} s, {summary['steps']} steps of {summary['dt']:.3g} s "
-                      f"({summary['method']}), {summary['frames']} frames"),
-        ("wall time", f"{summary['wall_time_s']:.3g} s ({summary['steps_per_second'] or 0:,.0f} steps/s, "
-                      f"{summary['node_steps_per_second'] or 0:,.0f} node-steps/s); "
-                      f"compile or cache load {summary['compile_time_s']:.2g} s"),
-    ]
+    rows = summary_rows(summary)
+    rows.append(("written", written(summary, folder)))
+    for key, value in rows:
+        table.add_row(key, value)
+    _console().print(table)
+
+
+def summary_rows(summary: dict) -> list[tuple[str, str]]:
+    """The run summary (``summary.json``) as (what, figures) rows, as `ropesim run` prints them (and the browser
+    viewer shows them); an unfinished run's short summary gives the rows it has."""
+    rows = []
+    if "steps" in summary and "method" in summary:
+        rows.append(("simulated", f"t = 0 .. {summary['t_end']:.6g} s, {summary['steps']} steps of "
+                                  f"{summary['dt']:.3g} s ({summary['method']}), {summary['frames']} frames"))
+    if "wall_time_s" in summary:
+        rows.append(("wall time", f"{summary['wall_time_s']:.3g} s ({summary['steps_per_second'] or 0:,.0f} "
+                                  f"steps/s, {summary['node_steps_per_second'] or 0:,.0f} node-steps/s); "
+                                  f"compile or cache load {summary['compile_time_s']:.2g} s"))
     if summary.get("dt_requested"):
         rows.append(("time step", f"{summary['dt_requested']:.6g} s shortened to {summary['dt']:.6g} s so "
                                   f"t_end is a whole number of steps"))
@@ -129,10 +140,7 @@ def print_summary(summary: dict, folder: Path) -> None:
                                       f"{'flowed' if ledger['relative_to'] == 'flows' else 'moved'})"))
     if summary.get("message"):
         rows.append(("stopped", summary["message"]))
-    rows.append(("written", written(summary, folder)))
-    for key, value in rows:
-        table.add_row(key, value)
-    _console().print(table)
+    return rows
 
 
 def written(summary: dict, folder: Path) -> str:

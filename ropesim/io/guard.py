@@ -28,11 +28,13 @@ from .runfolder import LOCK, RUN_MARKERS, STATE
 
 SOFTWARE = "ropesim"    # the tag ropesim puts in the pictures it writes (PNG Software, GIF and MP4 comment)
 PVD_MARK = "<!-- written by ropesim export -->"
+HTML_MARK = '<meta name="generator" content="ropesim view">'   # ropesim.viewer.page.GENERATOR
 
 # A run folder's own entries (see ropesim.io.runfolder) and what commands write into it by default.
 RUN_FILES = frozenset({*RUN_MARKERS, STATE, LOCK})
 DEFAULT_OUTPUTS = frozenset({"plots.png", "frames.png", "animation.gif", "animation.mp4", "trajectory.csv", "vtk",
-                             "trajectory_tension_history.csv", "trajectory_tension_range.csv"})
+                             "trajectory_tension_history.csv", "trajectory_tension_range.csv", "view.html",
+                             "overlay.html"})
 CSV_HEADERS = ("t [s],node,",                         # ropesim export --to csv
                "t [s],tension segment 0 [",           # ... its time history of the forces
                "segment,s [m],min tension [",         # ... its tension range along the rope
@@ -200,6 +202,8 @@ def written_by_ropesim(path: Path) -> bool:
             return line.startswith(CSV_HEADERS) or (path.name == "results.csv" and _sweep_header(line))
         if suffix == ".pvd":
             return PVD_MARK.encode() in _head(path, 200)
+        if suffix in (".html", ".htm"):
+            return HTML_MARK.encode() in _head(path, 1024)      # ropesim view's page
     except OSError:
         return False
     return False

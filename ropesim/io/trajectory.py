@@ -150,9 +150,16 @@ class Trajectory:
         from ..render.notebook import inline_animation
         return inline_animation(self, **options)
 
+    def view(self, **options):
+        """This run in the browser viewer (`ropesim view`'s page; options ``every``, ``start``, ``end`` as
+        :func:`ropesim.view`'s): a notebook shows it in a sandboxed iframe, ``.save(path)`` writes it."""
+        from ..viewer.page import view
+        return view(self, **options)
+
     def _repr_html_(self) -> str:
+        """In Jupyter: the short summary table, and the run in the viewer below it."""
         from ..render.notebook import summary_html
-        return summary_html(self)
+        return summary_html(self) + self.view()._repr_html_()
 
     def __repr__(self) -> str:
         return (f"Trajectory(scene={self.scene.name!r}, {self.summary.get('status', 'completed')}, "

@@ -18,11 +18,10 @@ from matplotlib.transforms import Affine2D
 
 from ..model.build import Model
 from .framing import BAND_REACH, Band, Box, Circle, Ground, Projection, outline
+from .marks import NODE_SIZE, Mark, moving_marks
 
 ROPE_COLOR = "#1f77b4"
-NODE_SIZE = 2.6          # [pt] marker of an ordinary node
 MARKED_NODES = 200       # ropes with more nodes are drawn as a plain line: markers would merge into a band
-HEAVY_MAX_SCALE = 4.0    # a heavy node's marker grows as sqrt(mass ratio), at most this many times
 CANOPY = Path.wedge(0.0, 180.0)  # the parachute marker: a half disc, open side down
 GEOMETRY = {"facecolor": "0.9", "edgecolor": "0.45", "linewidth": 1.0}
 
@@ -84,52 +83,23 @@ def _ground(shape: Ground) -> Polygon:
                    closed=True, zorder=1, **GEOMETRY)
 
 
+MARKERS = {"pinned": "s", "driven": "v", "heavy": "o", "parachute": CANOPY}
+ZORDER = {"pinned": 5, "driven": 6, "heavy": 5, "parachute": 5}
+
+
+def mark_style(mark: Mark) -> dict:
+    """The matplotlib marker style of a :class:`ropesim.render.marks.Mark`."""
+    return {"marker": MARKERS[mark.kind], "markersize": mark.size, "color": mark.color, "zorder": ZORDER[mark.kind]}
+
+
 def pinned_style() -> dict:
-    return {"marker": "s", "markersize": 6, "color": "black", "zorder": 5}
-
-
-def driven_style() -> dict:
-    return {"marker": "v", "markersize": 8, "color": "#d62728", "zorder": 6}
-
-
-def heavy_style(ratio: float) -> dict:
-    scale = min(max(np.sqrt(ratio), 1.5), HEAVY_MAX_SCALE)
-    return {"marker": "o", "markersize": 1.2 * NODE_SIZE * scale, "color": "0.15", "zorder": 5}
-
-
-def parachute_style() -> dict:
-    return {"marker": CANOPY, "markersize": 13, "color": "#ff7f0e", "zorder": 5}
+    return mark_style(Mark("pinned node", np.array([], dtype=int), "pinned"))
 
 
 def special_nodes(model: Model) -> list[tuple[str, np.ndarray, dict]]:
-    """(label, node indices, marker style) of the nodes drawn apart from the rope, in drawing order."""
-    scene, rope = model.scene, model.scene.rope
-    out = []
-    base_drag = scene.drag.b if scene.drag is not None else 0.0
-    for o in scene.overrides:
-        i = scene.node(o.index)
-        ends = i in (0, rope.nodes - 1) and not rope.closed
-        if o.mass is not None and o.mass > rope.mass:
-            name = "end mass" if ends else f"node {i}"
-            out.append((f"{name} {o.mass:g} kg", np.array([i]), heavy_style(o.mass / rope.mass)))
-        if o.drag is not None and o.drag > base_drag:
-            out.append((f"parachute, b = {o.drag:g} kg/s", np.array([i]), parachute_style()))
-    for body in scene.bodies:   # a body with mass is drawn as a heavy node, one with drag alone as a canopy
-        i = scene.node(body.node)
-        if body.mass > 0:
-            what = "body" if rope.closed or i not in (0, rope.nodes - 1) else "end body"
-            out.append((f"{what} {body.mass:g} kg" + (f", CdA {body.cd_area:g} m^2" if body.cd_area else ""),
-                        np.array([i]), heavy_style(model.mass[i] / rope.mass)))
-        elif body.cd_area > 0:
-            out.append((f"drag body, CdA {body.cd_area:g} m^2", np.array([i]), parachute_style()))
-    driven = sorted({scene.node(i) for d in scene.driven for i in d.nodes})
-    if driven:
-        if any(d.moving for d in scene.driven):   # a sinusoid or a path: no one speed to quote
-            out.append(("driven node", np.array(driven), driven_style()))
-        else:
-            speeds = ", ".join(f"{np.linalg.norm(d.velocity):g}" for d in scene.driven)
-            out.append((f"driven node ({speeds} m/s)", np.array(driven), driven_style()))
-    return out
+    """(label, node indices, marker style) of the nodes drawn apart from the rope, in drawing order (the pinned
+    ones are drawn with the fixed geometry)."""
+    return [(mark.label, mark.nodes, mark_style(mark)) for mark in moving_marks(model)]
 
 
 class RopeArtist:
