@@ -12,7 +12,7 @@ Nothing outside ropesim's own files is ever touched. So before a command writes:
 
 How ropesim knows its own files: a PNG, GIF or MP4 carries ``ropesim`` as its software or comment tag (every
 picture ropesim writes is tagged); a CSV starts with one of the headers ropesim writes; a VTK series' .pvd
-says so in a comment; inside a run folder (one with a manifest, scene or trajectory) the names ropesim gives
+says so in a comment; a page of ``ropesim view`` carries its generator tag; inside a run folder (one with a manifest, scene or trajectory) the names ropesim gives
 its files are its own (the run's files, and the pictures and exports written there by default). Refusals are
 :class:`WriteRefused` (one line; the command line exits 2).
 """
@@ -33,8 +33,7 @@ HTML_MARK = '<meta name="generator" content="ropesim view">'   # ropesim.viewer.
 # A run folder's own entries (see ropesim.io.runfolder) and what commands write into it by default.
 RUN_FILES = frozenset({*RUN_MARKERS, STATE, LOCK})
 DEFAULT_OUTPUTS = frozenset({"plots.png", "frames.png", "animation.gif", "animation.mp4", "trajectory.csv", "vtk",
-                             "trajectory_tension_history.csv", "trajectory_tension_range.csv", "view.html",
-                             "overlay.html"})
+                             "trajectory_tension_history.csv", "trajectory_tension_range.csv"})
 CSV_HEADERS = ("t [s],node,",                         # ropesim export --to csv
                "t [s],tension segment 0 [",           # ... its time history of the forces
                "segment,s [m],min tension [",         # ... its tension range along the rope
