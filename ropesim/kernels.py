@@ -24,7 +24,7 @@ from dataclasses import dataclass, replace
 from typing import Callable
 
 STATIC_SOLVER = "static solver"
-FIRST_COMPILE_SECONDS = (8, 30)   # a family's loop and terms, compiled once (scripts/bench_compile.py)
+FIRST_COMPILE_SECONDS = (5, 15)   # a scene's loop and terms, compiled once (scripts/bench_first_run.py)
 
 
 def loop_cached(scene) -> bool | None:

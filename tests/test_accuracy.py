@@ -320,7 +320,8 @@ def test_banded_newton_solver_matches_a_dense_solve(n, dim, bending, closed, see
     """The stiff integrator's linear solver (banded Cholesky, Woodbury correction for a loop's wrap-around)
     solves a random positive definite rope matrix, with springs between neighbours and second neighbours, as
     a dense solve does, to round-off."""
-    from ropesim.model.banded import factor, solve, woodbury
+    from ropesim.model import jit
+    from ropesim.model.banded import WITH_WRAP_AROUND, factor, solve, woodbury
     from ropesim.model.build import spring_count
     from ropesim.model.jacobian import Jacobian, add_pair, band_width
 
@@ -350,6 +351,8 @@ def test_banded_newton_solver_matches_a_dense_solve(n, dim, bending, closed, see
     dense[np.diag_indices(n * dim)] += mass
     rhs = rng.standard_normal(n * dim)
     p = band.shape[0] - 1
+    switches = frozenset({WITH_WRAP_AROUND.name} if closed else ())   # as a scene's switches
+    factor, solve = jit.specialise(factor, switches), jit.specialise(solve, switches)
     assert factor(band, corner, cyclic, p, wood)
     x = rhs.copy()
     solve(band, corner, cyclic, p, x, wood)

@@ -155,3 +155,27 @@ def test_a_declared_term_is_what_compiles(tmp_path):
     assert {"ropesim.model.forces.seabed.add_seabed_contact", "ropesim.model.forces.seabed.add_seabed_friction",
             "ropesim.model.forces.seabed.add_seabed_jacobian"} <= set(names)
     assert [n for n in names if n.startswith(UNUSED[:8]) and not n.startswith("ropesim.model.forces.seabed")] == []
+
+
+def test_the_bytecode_scan_finds_the_globals_dis_finds_in_every_kernel():
+    """jit._globals_read reads LOAD_GLOBAL straight from the bytecode; dis decodes it the slow, sure way."""
+    import dis
+    import importlib
+    import pkgutil
+
+    from numba.core.registry import CPUDispatcher
+
+    import ropesim
+
+    checked = 0
+    for info in pkgutil.walk_packages(ropesim.__path__, "ropesim."):
+        if info.name.endswith("__main__"):
+            continue
+        module = importlib.import_module(info.name)
+        for value in vars(module).values():
+            if isinstance(value, CPUDispatcher) and value.py_func.__module__ == module.__name__:
+                code = value.py_func.__code__
+                want = {op.argval for op in dis.get_instructions(code) if op.opname == "LOAD_GLOBAL"}
+                assert jit._globals_read(value.py_func) == want, value.py_func.__qualname__
+                checked += 1
+    assert checked > 80

@@ -56,7 +56,7 @@ def first_non_finite(x):
     return -1
 
 
-@jit.kernel
+@jit.kernel(inline="always")
 def check_health(x, v, mass, params, ledger, limits):
     """(status, node): OK and -1 when the state is sane, else the first problem found (see the module doc)."""
     energy, stretch, node = mechanical_energy(x, v, mass, params)

@@ -32,6 +32,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from ..model.banded import WITH_WRAP_AROUND
 from ..model.terms import WITH_GRAVITY
 from .health import DRAG
 from .kick import LANES, _lanes
@@ -51,7 +52,7 @@ their kinetic energy at t = 0 [J], whether any free node has drag, and the check
 def applies(model, scheme) -> bool:
     """True when ``model`` stepped by the splitting ``scheme`` can take the plain stage: a 2-D rope whose only
     force terms are its springs (that push as well as pull) and gravity."""
-    return (model.dim == 2 and model.nodes >= 2 and model.switches <= {WITH_GRAVITY.name}
+    return (model.dim == 2 and model.nodes >= 2 and model.switches <= {WITH_GRAVITY.name, WITH_WRAP_AROUND.name}
             and model.scene.rope.compression)
 
 

@@ -196,7 +196,7 @@ def take_back_half(X, step):
             X[d, i] -= step[i * dim + d]
 
 
-@jit.kernel
+@jit.kernel(inline="always")
 def solve_stage(stage, newton, beta, t_stage, t_piece, held, nodes, params):
     """Newton solve of one stage: X = xh + beta V, V = vh + beta (a(X, V) - gamma V). Returns
     (iterations, node, fluid power [W], internal-damping power [W]): iterations < 0 when it failed, naming the

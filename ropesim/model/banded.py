@@ -15,6 +15,9 @@ import numpy as np
 
 from . import jit
 
+WITH_WRAP_AROUND = jit.Switch("wrap_around", "a closed loop: the Woodbury correction of the Newton matrix's "
+                                             "wrap-around corner")
+
 Woodbury = namedtuple("Woodbury", ["wmat", "zmat", "a00", "g", "s", "small", "tmp"])
 """The wrap-around correction's arrays, m = w D: W and Z (N D, m), A00, G and S (m, m), dense-solve scratch
 (m, m + 1), a vector (m,). See :func:`factor`."""
@@ -130,7 +133,7 @@ def factor(band, corner, cyclic, p, wood):
     wmat, zmat, a00, g, s, small = wood.wmat, wood.zmat, wood.a00, wood.g, wood.s, wood.small
     nt = band.shape[1]
     m = a00.shape[0]
-    if cyclic:
+    if WITH_WRAP_AROUND and cyclic:
         for a in range(m):
             for b in range(m):
                 r, c = (a, b) if a >= b else (b, a)
@@ -146,7 +149,7 @@ def factor(band, corner, cyclic, p, wood):
                 band[a - b, nt - m + b] += val
     if not band_cholesky(band, p):
         return False
-    if cyclic:
+    if WITH_WRAP_AROUND and cyclic:
         wmat[:] = 0.0
         for a in range(m):
             wmat[a, a] = 1.0
@@ -176,7 +179,7 @@ def solve(band, corner, cyclic, p, rhs, wood):
     wmat, zmat, s, small, tmp = wood.wmat, wood.zmat, wood.s, wood.small, wood.tmp
     nt = band.shape[1]
     band_solve(band, p, rhs)
-    if cyclic:
+    if WITH_WRAP_AROUND and cyclic:
         m = s.shape[0]
         for a in range(m):
             val = 0.0

@@ -85,13 +85,23 @@ _copies: dict = {}
 COPY_SUFFIX = re.compile(r"__s[0-9a-f]+$")
 
 
+LOAD_GLOBAL, EXTENDED_ARG = dis.opmap["LOAD_GLOBAL"], dis.EXTENDED_ARG
+
+
 def _globals_read(function) -> set[str]:
     """The global names ``function``'s code loads (nested code objects included; not attribute names, which
-    share ``co_names`` with them)."""
+    share ``co_names`` with them). Read straight from the bytecode (``dis.get_instructions`` took a tenth of a
+    second per run for the families' call graphs): LOAD_GLOBAL's argument is the name's index times two
+    (Python 3.11 and later), an EXTENDED_ARG prefix its high bits."""
     names, stack = set(), [function.__code__]
     while stack:
         code = stack.pop()
-        names.update(op.argval for op in dis.get_instructions(code) if op.opname in ("LOAD_GLOBAL", "LOAD_NAME"))
+        raw, high = code.co_code, 0
+        for i in range(0, len(raw), 2):
+            op, arg = raw[i], raw[i + 1] | high
+            high = arg << 8 if op == EXTENDED_ARG else 0
+            if op == LOAD_GLOBAL:
+                names.add(code.co_names[arg >> 1])
         stack.extend(c for c in code.co_consts if isinstance(c, types.CodeType))
     return names
 

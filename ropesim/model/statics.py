@@ -43,7 +43,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .banded import factor, solve, woodbury
+from .banded import factor as factor_newton_matrix
+from .banded import solve as solve_newton_matrix
+from .banded import woodbury
 from .jacobian import Jacobian, band_width
 from .forces.fluid import WITH_FLUID_DRAG, WITH_VISCOUS_DRAG, add_fluid_tangent_stiffness
 from .terms import accelerations, coupling_reach, mechanical_energy, newton_matrix, velocity_accelerations
@@ -88,8 +90,9 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     x = np.array(model.x0 if x is None else x, dtype=float)
     dim, n = x.shape
     scene, p = model.scene, model.params
-    static_force, nonconservative, energy_of, jacobian, tangent_stiffness = (model.kernel(f) for f in (
-        forces_on_free_nodes, nonconservative_forces, mechanical_energy, newton_matrix, add_fluid_tangent_stiffness))
+    static_force, nonconservative, energy_of, jacobian, tangent_stiffness, factor, solve = (model.kernel(f) for f in (
+        forces_on_free_nodes, nonconservative_forces, mechanical_energy, newton_matrix, add_fluid_tangent_stiffness,
+        factor_newton_matrix, solve_newton_matrix))
     free = np.ascontiguousarray(~model.held)
     mass = model.mass
     v = np.zeros_like(x)

@@ -10,7 +10,8 @@ calls) with the undeclared terms' branches removed before Numba types them. An u
 empty parameters of the same types, so the bundle has one layout for every scene.
 
 Besides one switch per optional term there are two derived from the term records (:data:`WITH_VELOCITY_TERMS`,
-:data:`WITH_APPLIED`), and :data:`WITH_MOTION` for held nodes with a prescribed motion.
+:data:`WITH_APPLIED`), :data:`~ropesim.model.banded.WITH_WRAP_AROUND` for a closed loop's Newton matrix, and
+:data:`WITH_MOTION` for held nodes with a prescribed motion.
 
 Compiled entry points, each the term list in one form:
 
@@ -51,6 +52,7 @@ from .forces.seabed import (SEABED_TERM, WITH_SEABED, add_seabed_contact, add_se
                             seabed_energy)
 from .forces.thrower import THROWER as THROWER_TERM
 from .forces.thrower import WITH_THROWER, add_thrower, add_thrower_jacobian
+from .banded import WITH_WRAP_AROUND
 from .jacobian import pair_damper_blocks, pair_spring_blocks
 from . import jit
 
@@ -86,10 +88,13 @@ def declared_terms(scene) -> tuple:
 
 
 def switches(scene) -> jit.Switches:
-    """The compile-time switches of ``scene``'s terms: each declared term's, and the two derived from their
-    records (velocity-dependent terms, terms booked as box work). :data:`WITH_MOTION` is the model's to add."""
+    """The compile-time switches of ``scene``'s terms: each declared term's, the two derived from their
+    records (velocity-dependent terms, terms booked as box work), and a closed loop's wrap-around in the
+    Newton matrix. :data:`WITH_MOTION` is the model's to add."""
     declared = declared_terms(scene)
     on = {term.switch.name for term in declared if term.switch is not None}
+    if scene.rope.closed:
+        on.add(WITH_WRAP_AROUND.name)
     if any(term.velocity for term in declared):
         on.add(WITH_VELOCITY_TERMS.name)
     if any(term.ledger == "box" for term in declared):
@@ -223,7 +228,7 @@ def mechanical_energy(x, v, mass, p):
     return e, stretch, node
 
 
-@jit.kernel
+@jit.kernel(inline="always")
 def coupling_jacobian(x, jac, beta, free, p):
     """Add the coupling terms' blocks for a stage of coefficient beta = gamma h: beta^2 times the springs' and
     bending's stiffness, beta times the axial damping."""
@@ -238,7 +243,7 @@ def coupling_jacobian(x, jac, beta, free, p):
         add_ei_jacobian(x, jac, beta, free, p.bending_ei, p.spring[1], closed)
 
 
-@jit.kernel
+@jit.kernel(inline="always")
 def node_jacobian(x, v, band, beta, mass, free, p, t):
     """Add the node-local terms' blocks (the thrower's, the guides', the fluid's, added mass) to the Newton
     matrix's ``band``, for a stage of coefficient beta = gamma h at time t (see :mod:`ropesim.model.jacobian`)."""
