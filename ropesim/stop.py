@@ -15,10 +15,14 @@ class Stopped(BaseException):
 
 
 def _interrupted_while_loading(_signum, _frame):
+    """Nothing is written yet while modules load: say so and end at once (an exception raised here could land
+    in any library's import, which may swallow or wrap it)."""
+    import os
     import sys
 
     sys.stderr.write("ropesim: interrupted\n")
-    raise SystemExit(130)
+    sys.stderr.flush()
+    os._exit(130)
 
 
 def quiet_interrupts_while_loading(on: bool = True) -> None:
