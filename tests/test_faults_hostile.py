@@ -78,6 +78,7 @@ def _start_long_run(folder: Path) -> subprocess.Popen:
     return proc
 
 
+@pytest.mark.slow
 def test_ctrl_c_inside_what_was_one_long_chunk_is_honoured_at_once(tmp_path):
     folder = tmp_path / "run"
     proc = _start_long_run(folder)
@@ -95,6 +96,7 @@ def test_ctrl_c_inside_what_was_one_long_chunk_is_honoured_at_once(tmp_path):
     assert f"ropesim run --resume {folder}" in one_line(err)
 
 
+@pytest.mark.slow
 def test_kill_9_keeps_a_checkpoint_no_older_than_the_interval(tmp_path):
     """kill -9 seven seconds in: a checkpoint is written at least every 5 s (CHECKPOINT_SECONDS), so frames past
     t = 0 survive (the former single chunk kept only the t = 0 frame)."""
@@ -179,6 +181,7 @@ def test_a_rerun_keeps_and_names_files_the_user_added(tmp_path):
     assert (folder / "notes.md").read_text() == "what I saw" and Trajectory.open(folder).t[-1] == 0.2
 
 
+@pytest.mark.slow
 def test_pictures_and_exports_replace_their_own_files(tmp_path, run_folder):
     for command in ("export csv", "frames", "plot", "animate", "export vtk"):
         for _ in range(2):                        # the second time replaces what the first wrote
@@ -186,6 +189,7 @@ def test_pictures_and_exports_replace_their_own_files(tmp_path, run_folder):
             assert code == 0, (command, err)
 
 
+@pytest.mark.slow
 def test_run_into_a_symlink_writes_to_its_target(tmp_path):
     """The link was replaced by a real folder, a hidden .NAME.new-* link stayed, and a stale .lock in the
     target; now the run goes where the link points."""
@@ -565,6 +569,7 @@ def test_csv_bombs_are_one_line(tmp_path):
 # ------------------------------------------------------------------------------------------------ sweeps
 
 
+@pytest.mark.slow
 def test_a_sweep_of_10_000_runs_stopped_by_ctrl_c(tmp_path):
     """It left 9,919 empty run folders, listed the runs never started as "error" and reported "10000 runs
     (10000 run now, 0 kept)"."""

@@ -685,6 +685,7 @@ def test_random_set_overrides_are_accepted_or_refused_in_one_line(raw, items):
     _accepted_or_one_line(tomli_w.dumps(raw), sets)
 
 
+@pytest.mark.slow
 @FUZZ
 @given(rescaled_scenes())
 def test_rescaled_scenes_are_refused_in_one_line_or_run_cleanly(raw):
