@@ -22,7 +22,11 @@ class Spec:
     """What one TOML key may hold.
 
     kind: "int", "float", "bool", "str", "vector" (one number per dimension), "int_list", "float_list",
-    "points" (a list of vectors) or "rows" (a table: rows of a time and one number per dimension). ``low``/``high`` bound numbers (``open_low`` makes the lower bound strict).
+    "points" (a list of vectors) or "rows" (a table: rows of a time and one number per dimension); for rigid
+    bodies "angles" (one number per axis of rotation: 3 in 3-D, 1 in 2-D), "dofs" (a vector, then its angles:
+    6 in 3-D, 3 in 2-D), "dof_rows" (rows of a time and the dofs) and "inertia" (3-D: 3 principal moments or 6,
+    Ixx Iyy Izz Ixy Ixz Iyz; 2-D: 1). ``low``/``high`` bound numbers (``open_low`` makes the lower bound
+    strict).
     """
 
     kind: str
@@ -261,6 +265,216 @@ class Body:
     ca: float = spec("float", "its added-mass coefficient", default=0.0, low=0)
 
 
+# ---------------------------------------------------------------------------------------- systems
+#
+# A system is lines joined at points and rigid bodies, as MoorDyn and OrcaFlex model moorings: every line end
+# sits on a point, and a point is fixed, free (it moves under its lines' pull, its own weight, buoyancy and
+# drag), driven (a prescribed motion) or fixed on a body (at a position in the body's frame). A scene is either
+# one rope ([rope], the course's form) or a system ([[lines]], [[points]] and [[bodies]] with an id).
+
+
+@dataclass(frozen=True)
+class LineType:
+    """A line material, named under ``[line_types.NAME]`` and used by ``[[lines]]`` through ``type = "NAME"``:
+    the physical form of ``[rope]`` (diameter, mass per metre or density, EA, axial damping BA, EI), and the
+    fluid coefficients of lines of this type where they differ from the scene's ``[fluid_drag]`` and
+    ``[added_mass]`` (MoorDyn's line types carry Cd, Ca, CdAx and CaAx)."""
+
+    diameter: float | None = spec("float", "diameter d: the area drag, buoyancy and added mass act on", "m",
+                                  default=None, required=False, low=0, open_low=True)
+    mass_per_length: float | None = spec("float", "mass per metre", "kg/m", default=None, required=False, low=0,
+                                         open_low=True)
+    density: float | None = spec("float", "material density; with diameter, the mass per metre rho pi d^2 / 4",
+                                 "kg/m^3", default=None, required=False, low=0, open_low=True)
+    EA: float | None = spec("float", "axial stiffness EA", "N", default=None, required=False, low=0, open_low=True)
+    axial_damping: float | None = spec("float", "internal damping BA: force BA (dl/dt) / l along each segment",
+                                       "N s", default=None, required=False, low=0)
+    EI: float | None = spec("float", "bending stiffness EI: energy EI (1 - cos theta) / l at each joint",
+                            "N m^2", default=None, required=False, low=0, open_low=True)
+    compression: bool | None = spec("bool", "segments push back when shorter than their rest length (default "
+                                            "false: a rope or chain goes slack)", default=None, required=False)
+    cd_normal: float | None = spec("float", "normal drag coefficient Cd_n (default: [fluid_drag]'s)", default=None,
+                                   required=False, low=0)
+    cd_tangential: float | None = spec("float", "tangential drag coefficient Cd_t (default: [fluid_drag]'s)",
+                                       default=None, required=False, low=0)
+    ca_normal: float | None = spec("float", "normal added-mass coefficient Ca_n (default: [added_mass]'s)",
+                                   default=None, required=False, low=0)
+    ca_tangential: float | None = spec("float", "tangential added-mass coefficient Ca_t (default: "
+                                                "[added_mass]'s)", default=None, required=False, low=0)
+
+
+MATERIAL_KEYS = tuple(f for f in LineType.__dataclass_fields__)
+
+
+@dataclass(frozen=True)
+class Line:
+    """A line of a system from point ``start`` to point ``end``: ``length`` unstretched, cut into ``segments``
+    segments, of material ``type`` (a ``[line_types]`` name) or given by the material keys themselves (a key
+    given here overrides the type's). Its N = segments + 1 nodes are lumped as ``[rope]``'s in physical units:
+    each node carries half of each segment it touches, so the end nodes carry half a segment, which moves with
+    the point they sit on."""
+
+    id: str = spec("str", "the line's name (in outputs, and for a point's or body's lines)")
+    start: str = spec("str", "the point its first node sits on")
+    end: str = spec("str", "the point its last node sits on")
+    length: float = spec("float", "unstretched length", "m", low=0, open_low=True)
+    segments: int = spec("int", "number of segments", low=1, high=1_000_000)
+    type: str | None = spec("str", "its material, a name in [line_types]", default=None, required=False)
+    diameter: float | None = spec("float", "diameter d: the area drag, buoyancy and added mass act on", "m",
+                                  default=None, required=False, low=0, open_low=True)
+    mass_per_length: float | None = spec("float", "mass per metre", "kg/m", default=None, required=False, low=0,
+                                         open_low=True)
+    density: float | None = spec("float", "material density; with diameter, the mass per metre rho pi d^2 / 4",
+                                 "kg/m^3", default=None, required=False, low=0, open_low=True)
+    EA: float | None = spec("float", "axial stiffness EA", "N", default=None, required=False, low=0, open_low=True)
+    axial_damping: float | None = spec("float", "internal damping BA: force BA (dl/dt) / l along each segment",
+                                       "N s", default=None, required=False, low=0)
+    EI: float | None = spec("float", "bending stiffness EI: energy EI (1 - cos theta) / l at each joint",
+                            "N m^2", default=None, required=False, low=0, open_low=True)
+    compression: bool | None = spec("bool", "segments push back when shorter than their rest length (default "
+                                            "false: a rope or chain goes slack)", default=None, required=False)
+    cd_normal: float | None = spec("float", "normal drag coefficient Cd_n (default: the type's, or [fluid_drag]'s)",
+                                   default=None, required=False, low=0)
+    cd_tangential: float | None = spec("float", "tangential drag coefficient Cd_t (default: the type's, or "
+                                                "[fluid_drag]'s)", default=None, required=False, low=0)
+    ca_normal: float | None = spec("float", "normal added-mass coefficient Ca_n (default: the type's, or "
+                                            "[added_mass]'s)", default=None, required=False, low=0)
+    ca_tangential: float | None = spec("float", "tangential added-mass coefficient Ca_t (default: the type's, "
+                                                "or [added_mass]'s)", default=None, required=False, low=0)
+
+    @property
+    def nodes(self) -> int:
+        return self.segments + 1
+
+    @property
+    def segment_length(self) -> float:
+        return self.length / self.segments
+
+
+POINT_KINDS = ("fixed", "free", "driven", "body")
+
+
+@dataclass(frozen=True)
+class Point:
+    """A point of a system, where line ends meet: ``fixed`` (an anchor), ``free`` (a connector, a clump weight,
+    a buoy: it moves under the pull of its lines, its weight less buoyancy, its drag -1/2 rho CdA |u| u on the
+    velocity u relative to the flow, with added mass rho Ca V, MoorDyn's free point), ``driven`` (moved along a
+    prescribed path: the motion keys of ``[[driven]]``, exactly at every stage) or ``body`` (fixed on rigid body
+    ``body`` at ``position`` in the body's frame, a fairlead). Every line end on a point moves with it, and its
+    node's mass (half a segment) joins the point's."""
+
+    id: str = spec("str", "the point's name, which lines name as their start or end")
+    position: tuple = spec("vector", "position (of a body's point: in the body's frame, from its reference "
+                                     "point)", "m")
+    kind: str | None = spec("str", "fixed, free, driven, or body (default: body when a body is named, else "
+                                   "fixed)", default=None, required=False, choices=POINT_KINDS)
+    body: str | None = spec("str", "the rigid body it is fixed on (kind = body)", default=None, required=False)
+    mass: float = spec("float", "free point: its own mass (a clump weight, a connector)", "kg", default=0.0,
+                       low=0)
+    volume: float = spec("float", "free point: its displaced volume (buoyancy, added mass)", "m^3", default=0.0,
+                         low=0)
+    cd_area: float = spec("float", "free point: drag coefficient times area, CdA", "m^2", default=0.0, low=0)
+    ca: float = spec("float", "free point: added-mass coefficient (on its volume)", default=0.0, low=0)
+    velocity: tuple | None = spec("vector", "driven: the constant velocity V", "m/s", default=None, required=False)
+    amplitude: tuple | None = spec("vector", "driven: sinusoid amplitude A per axis", "m", default=None,
+                                   required=False)
+    period: tuple | None = spec("vector", "driven: sinusoid period T per axis (ignored where A = 0)", "s",
+                                default=None, required=False)
+    phase: tuple | None = spec("vector", "driven: sinusoid phase per axis", "deg", default=None, required=False)
+    path: str | None = spec("str", "driven: CSV file of t, dx, dy[, dz] rows (relative to the scene file's folder)",
+                            default=None, required=False)
+    path_table: tuple | None = spec("rows", "driven: the path inline, rows [t, dx, dy(, dz)]", "s, m",
+                                    default=None, required=False)
+    ramp_time: float = spec("float", "driven: time over which the sinusoid and the path ramp in (0: at once)",
+                            "s", default=0.0, low=0)
+
+    @property
+    def moving(self) -> bool:
+        return self.amplitude is not None or self.path is not None or self.path_table is not None
+
+
+BODY_KINDS = ("free", "fixed", "driven")
+
+
+@dataclass(frozen=True)
+class RigidBody:
+    """A rigid body of a system (a spar, a buoy, a container): 6 degrees of freedom in 3-D, 3 in 2-D (x, y and
+    the angle about z). Its frame's origin is its reference point ``position`` (the point its motion and forces
+    are reported at), turned by ``orientation``: rotations about x, then y, then z (3-D; MoorDyn's roll, pitch
+    and yaw, here in ropesim's frame with y up), or the angle about z (2-D). Its mass sits at
+    ``center_of_gravity`` with the inertia ``inertia`` about it in body axes; buoyancy rho V g acts at
+    ``center_of_buoyancy``; drag -1/2 rho CdA_i |u| u_i on the velocity u of the reference point relative to
+    the flow, in body axes (and -1/2 rho Cd_i |w| w_i on the rotation rate w); added mass and inertia on the
+    body's axes at the reference point (MoorDyn's body conventions). Lines attach through points with
+    ``body = this id``. ``free``: it moves under every force, by the Newton-Euler equations (the gyroscopic
+    moment w x I w included); ``fixed``: it stays; ``driven``: it follows a prescribed motion, a constant
+    velocity and rotation rate plus a sinusoid and a path per degree of freedom."""
+
+    id: str = spec("str", "the body's name, which points name to sit on it")
+    position: tuple = spec("vector", "its reference point (the origin of its frame) at t = 0", "m")
+    kind: str = spec("str", "free, fixed or driven", default="free", choices=BODY_KINDS)
+    orientation: tuple | None = spec("angles", "its orientation at t = 0: rotations about x, y, z (3-D) or about z "
+                                               "(2-D)", "deg", default=None, required=False)
+    mass: float = spec("float", "its mass", "kg", default=0.0, low=0)
+    center_of_gravity: tuple | None = spec("vector", "its centre of gravity, in its frame", "m", default=None,
+                                           required=False)
+    inertia: tuple | None = spec("inertia", "its moments of inertia about the centre of gravity, in body axes: "
+                                            "Ixx Iyy Izz (3-D, optionally then Ixy Ixz Iyz) or Izz (2-D)",
+                                 "kg m^2", default=None, required=False)
+    volume: float = spec("float", "its displaced volume (buoyancy)", "m^3", default=0.0, low=0)
+    center_of_buoyancy: tuple | None = spec("vector", "the centre of its displaced volume, in its frame", "m",
+                                            default=None, required=False)
+    cd_area: tuple | None = spec("vector", "drag coefficient times area along each body axis, CdA", "m^2",
+                                 default=None, required=False)
+    cd_rotation: tuple | None = spec("angles", "rotational drag coefficient about each body axis: moment "
+                                               "-1/2 rho Cd |w| w", "m^5", default=None, required=False)
+    added_mass: tuple | None = spec("vector", "added mass along each body axis (rho V Ca_i)", "kg", default=None,
+                                    required=False)
+    added_inertia: tuple | None = spec("angles", "added moment of inertia about each body axis", "kg m^2",
+                                       default=None, required=False)
+    velocity: tuple | None = spec("vector", "driven: constant velocity of the reference point", "m/s",
+                                  default=None, required=False)
+    angular_velocity: tuple | None = spec("angles", "driven: constant rotation rate", "deg/s", default=None,
+                                          required=False)
+    amplitude: tuple | None = spec("dofs", "driven: sinusoid amplitude per degree of freedom (translations, then "
+                                           "rotations)", "m, deg", default=None, required=False)
+    period: tuple | None = spec("dofs", "driven: sinusoid period per degree of freedom (ignored where the "
+                                        "amplitude is 0)", "s", default=None, required=False)
+    phase: tuple | None = spec("dofs", "driven: sinusoid phase per degree of freedom", "deg", default=None,
+                               required=False)
+    path: str | None = spec("str", "driven: CSV file of rows t, then the displacement per degree of freedom "
+                                   "(m, deg)", default=None, required=False)
+    path_table: tuple | None = spec("dof_rows", "driven: the path inline, rows [t, then one value per degree of "
+                                                "freedom]", "s, m, deg", default=None, required=False)
+    ramp_time: float = spec("float", "driven: time over which the sinusoid and the path ramp in (0: at once)",
+                            "s", default=0.0, low=0)
+
+    @property
+    def moving(self) -> bool:
+        return self.amplitude is not None or self.path is not None or self.path_table is not None
+
+
+@dataclass(frozen=True)
+class StraightLinesStart:
+    """A system's start: every line from its start point to its end point, straight, or sagging in a parabola
+    below the chord when it is longer than the distance between them (over a seabed, lifted onto it); every
+    point and body at rest where the scene puts it. The default."""
+
+    shape: str = "lines"
+
+
+@dataclass(frozen=True)
+class SystemEquilibriumStart:
+    """A system's static shape, found by ``ropesim equilibrium``'s solver before the run from the ``lines``
+    start: every free node, free point and free body in static balance (weight, buoyancy, springs, bending, the
+    seabed, drag in a steady flow), the fixed and driven ones where the scene holds them."""
+
+    shape: str = "equilibrium"
+
+
+SYSTEM_INITIAL_SHAPES = {"lines": StraightLinesStart, "equilibrium": SystemEquilibriumStart}
+
+
 # -------------------------------------------------------------------------------- initial shapes
 
 
@@ -494,11 +708,13 @@ class Output:
 
 @dataclass(frozen=True)
 class Scene:
-    """One complete, validated simulation: the parts it declares, and nothing else."""
+    """One complete, validated simulation: the parts it declares, and nothing else. Either one rope (``rope``,
+    with ``pinned``, ``driven``, ``overrides`` and point ``bodies`` on its nodes) or a system (``lines`` between
+    ``points``, ``rigid_bodies``, ``line_types``); ``rope`` is None in a system."""
 
     name: str
     dimension: int
-    rope: Rope
+    rope: Rope | None
     initial: InitialShape
     integrator: Integrator
     output: Output = Output()
@@ -519,6 +735,15 @@ class Scene:
     driven: tuple[Driven, ...] = ()
     overrides: tuple[NodeOverride, ...] = ()
     bodies: tuple[Body, ...] = ()
+    line_types: tuple[tuple[str, LineType], ...] = ()
+    lines: tuple[Line, ...] = ()
+    points: tuple[Point, ...] = ()
+    rigid_bodies: tuple[RigidBody, ...] = ()
+
+    @property
+    def is_system(self) -> bool:
+        """True for lines joined at points and bodies; False for one rope."""
+        return bool(self.lines)
 
     def node(self, index: int) -> int:
         """The non-negative index of ``index`` (negative counts from the end)."""
@@ -549,8 +774,17 @@ TABLES = {
     "integrator": Integrator,
     "output": Output,
 }
-ARRAYS_OF_TABLES = {"guides": Guide, "driven": Driven, "overrides": NodeOverride, "bodies": Body}
+ARRAYS_OF_TABLES = {"guides": Guide, "driven": Driven, "overrides": NodeOverride, "bodies": Body, "lines": Line,
+                    "points": Point}
+"""``[[bodies]]`` holds a rope's point bodies (an entry with ``node``, :class:`Body`) or a system's rigid bodies
+(an entry with ``id``, :class:`RigidBody`, kept in ``Scene.rigid_bodies``)."""
+NAMED_TABLES = {"line_types": LineType}
+"""Tables of named tables: ``[line_types.chain]``, ``[line_types.polyester]``, ..."""
 REQUIRED_TABLES = ("rope", "initial", "integrator")
+SYSTEM_REQUIRED_TABLES = ("lines", "points", "integrator")
+ROPE_ONLY_TABLES = ("rope", "pinned", "driven", "overrides", "thrower", "guides", "drag", "bending")
+"""What a system has no use for: parts of one rope's nodes, the string shooter, and the per-node linear drag
+and second-neighbour springs of the course's form (a system's lines are given in physical units)."""
 
 
 def scene_to_dict(scene: Scene) -> dict:
@@ -580,8 +814,12 @@ def scene_to_dict(scene: Scene) -> dict:
         part = getattr(scene, key)
         if part is not None:
             out[key] = table(part)
+    for key, _ in NAMED_TABLES.items():
+        named = getattr(scene, key)
+        if named:
+            out[key] = {name: table(item) for name, item in named}
     for key in ARRAYS_OF_TABLES:
-        items = getattr(scene, key)
+        items = getattr(scene, key) + (scene.rigid_bodies if key == "bodies" else ())
         if items:
             out[key] = [table(item) for item in items]
     return out
