@@ -161,9 +161,9 @@ def test_the_plain_check_measures_what_the_general_one_does(tmp_path, closed):
     v = rng.normal(size=model.x0.shape)
     lengths, terms = np.zeros(model.nodes), np.zeros(model.nodes)
     spring, g = model.params.spring, model.params.gravity[0]
-    fast = plain.chain_energy(x, v, model.mass, spring[0], spring[1], closed, g, lengths, terms)
+    fast = plain.chain_energy(x, v, model.mass, spring[0, 0], spring[0, 1], closed, g, lengths, terms)
     general = model.kernel(mechanical_energy)(x, v, model.mass, model.params)
     assert fast[0] == pytest.approx(general[0], rel=1e-12)
     assert fast[1:] == general[1:]
     x[1, 3] = np.nan
-    assert not np.isfinite(plain.chain_energy(x, v, model.mass, spring[0], spring[1], closed, g, lengths, terms)[0])
+    assert not np.isfinite(plain.chain_energy(x, v, model.mass, spring[0, 0], spring[0, 1], closed, g, lengths, terms)[0])

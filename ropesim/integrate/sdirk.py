@@ -139,7 +139,6 @@ def stage_residual(stage, rhs, beta, t_stage, held, nodes, params):
     held_idx, held_v = held.idx, held.v
     free, mass, drag = nodes
     dim, n = X.shape
-    closed = params.spring[2] != 0.0
     for d in range(dim):
         for i in range(n):
             V[d, i] = (X[d, i] - xh[d, i]) / beta
@@ -160,7 +159,7 @@ def stage_residual(stage, rhs, beta, t_stage, held, nodes, params):
             w0 = X[0, i] - xh[0, i] - beta * vh[0, i]
             w1 = X[1, i] - xh[1, i] - beta * vh[1, i]
             w2 = X[2, i] - xh[2, i] - beta * vh[2, i] if dim == 3 else 0.0
-            extra = added_mass_times(X, i, w0, w1, w2, params.added_mass, closed)
+            extra = added_mass_times(X, i, w0, w1, w2, params.added_mass, params.neighbours)
             for d in range(dim):
                 rhs[i * dim + d] -= extra[d]
     norm = 0.0

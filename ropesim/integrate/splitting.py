@@ -247,7 +247,7 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
     n_held = held_idx.shape[0]
     inv_mass = params.inv_mass
     g = params.gravity[0] if WITH_GRAVITY else 0.0
-    k_spring, rest, closed = params.spring[0], params.spring[1], params.spring[2] != 0.0
+    k_spring, rest, closed = params.spring[0, 0], params.spring[0, 1], params.spring[0, 2] != 0.0   # one line
     px, py, vx, vy, fx, fy = x[0], x[1], v[0], v[1], f[0], f[1]   # the plain stage's rows
     inv_m = plain.bulk[0]
     n_exc = plain.exceptions.shape[0]

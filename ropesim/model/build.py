@@ -19,6 +19,7 @@ import numpy as np
 
 from ..scene import schema as S
 from ..scene.shapes import initial_positions
+from .layout import LineLayout, line_layouts, node_lengths
 from .motion import Motion, motion_of
 from . import jit
 from .terms import WITH_APPLIED, WITH_MOTION, WITH_VELOCITY_TERMS, Layout, ModelParams, model_params, switches
@@ -40,6 +41,7 @@ class Model:
     params: ModelParams       # the force terms' parameters, for the compiled code
     motion: Motion            # the held nodes' prescribed motion beyond x0 + V t (see model/motion.py)
     switches: jit.Switches    # the compile-time switches that are on: the scene's terms, prescribed motion
+    lines: tuple[LineLayout, ...]   # each line's nodes and material (a rope: one line)
 
     @property
     def dim(self) -> int:
@@ -86,6 +88,7 @@ class Model:
 def build(scene: S.Scene, solve: bool = True) -> Model:
     """Lay out ``scene`` for the kernel; an ``equilibrium`` start is solved for its static shape (unless
     ``solve`` is False: it then holds the solver's first guess, see :mod:`ropesim.analysis.statics`)."""
+    lines = line_layouts(scene)
     n, dim = scene.rope.nodes, scene.dimension
     x0 = initial_positions(scene)
     v0 = np.empty((dim, n))
@@ -118,12 +121,12 @@ def build(scene: S.Scene, solve: bool = True) -> Model:
     held_idx = np.flatnonzero(held).astype(np.int64)
     v0[:, held_idx] = held_v[:, held_idx]
 
-    layout = Layout(mass, held, node_lengths(scene))
+    layout = Layout(mass, held, node_lengths(lines, n), lines)
     motion = motion_of(scene, held_idx)
     model = Model(scene=scene, x0=x0, v0=v0, mass=mass, drag=drag, held=held, held_idx=held_idx,
                   held_x0=np.ascontiguousarray(x0[:, held_idx]), held_v=np.ascontiguousarray(held_v[:, held_idx]),
                   params=model_params(scene, layout), motion=motion,
-                  switches=switches(scene) | ({WITH_MOTION.name} if motion.moving else set()))
+                  switches=switches(scene) | ({WITH_MOTION.name} if motion.moving else set()), lines=lines)
     if solve and isinstance(scene.initial, S.EquilibriumStart):
         from .statics import solve_equilibrium
 
@@ -138,15 +141,6 @@ def build(scene: S.Scene, solve: bool = True) -> Model:
 
 class EquilibriumError(ValueError):
     """A scene whose static shape could not be found; ``str()`` is one line for the user."""
-
-
-def node_lengths(scene: S.Scene) -> np.ndarray:
-    """Each node's share of the rope's unstretched length [m]: half of each segment it touches."""
-    rope = scene.rope
-    length = np.full(rope.nodes, rope.segment_length)
-    if not rope.closed:
-        length[[0, -1]] *= 0.5
-    return length
 
 
 def spring_count(n: int, stride: int, closed: bool) -> int:

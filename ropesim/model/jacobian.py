@@ -69,8 +69,9 @@ def add_pair(jac, n, i, j, free_i, free_j):
 
 
 @jit.kernel
-def pair_spring_blocks(x, jac, k, rest, stride, closed, scale, free, slack):
-    """Add ``scale`` times the stiffness of every spring (i, i + stride) of constant k [N/m] and rest length [m].
+def pair_spring_blocks(x, jac, k, rest, stride, closed, scale, free, slack, first, end):
+    """Add ``scale`` times the stiffness of every spring (i, i + stride) of constant k [N/m] and rest length [m]
+    of the line of nodes ``first`` .. ``end`` - 1.
 
     A spring's stiffness block is k [(1 - g) u u^T + g I] with g = 1 - l0 / r, u its unit vector;
     compressive (negative) geometric stiffness is left out (g >= 0), so the matrix stays positive definite. A
@@ -78,11 +79,11 @@ def pair_spring_blocks(x, jac, k, rest, stride, closed, scale, free, slack):
     """
     dim, n = x.shape
     blk = jac.blk
-    count = n if closed else n - stride
-    for i in range(count):
+    count = end - first if closed else end - first - stride
+    for i in range(first, first + count):
         j = i + stride
-        if j >= n:
-            j -= n
+        if j >= end:
+            j -= end - first
         if i == j or not (free[i] or free[j]):
             continue
         r2 = 0.0
@@ -103,13 +104,14 @@ def pair_spring_blocks(x, jac, k, rest, stride, closed, scale, free, slack):
 
 
 @jit.kernel
-def pair_damper_blocks(x, jac, c, closed, scale, free):
-    """Add ``scale`` times the damping c u u^T [N s/m] of every segment (i, i + 1) (the rope's axial damping)."""
+def pair_damper_blocks(x, jac, c, closed, scale, free, first, end):
+    """Add ``scale`` times the damping c u u^T [N s/m] of every segment (i, i + 1) of the line of nodes
+    ``first`` .. ``end`` - 1 (the line's axial damping)."""
     dim, n = x.shape
     blk = jac.blk
-    count = n if closed else n - 1
-    for i in range(count):
-        j = i + 1 if i + 1 < n else 0
+    count = end - first if closed else end - first - 1
+    for i in range(first, first + count):
+        j = i + 1 if i + 1 < end else first
         if not (free[i] or free[j]):
             continue
         r2 = 0.0

@@ -53,6 +53,8 @@ from .forces.seabed import (SEABED_TERM, WITH_SEABED, add_seabed_contact, add_se
 from .forces.thrower import THROWER as THROWER_TERM
 from .forces.thrower import WITH_THROWER, add_thrower, add_thrower_jacobian
 from .banded import WITH_WRAP_AROUND
+from .forces.fluid import neighbours
+from .layout import line_layouts, line_table
 from .jacobian import pair_damper_blocks, pair_spring_blocks
 from . import jit
 
@@ -66,20 +68,27 @@ WITH_APPLIED = jit.Switch("applied", "a term whose work the ledger books as box_
 WITH_MOTION = jit.Switch("motion", "a held node with a prescribed motion beyond x0 + V t")
 
 ModelParams = namedtuple("ModelParams", [
-    "inv_mass", "node_length", "spring", "bending", "gravity", "buoyancy", "thrower", "guides", "axial",
-    "fluid_drag", "viscous_drag", "body_drag", "flow", "flow_push", "added_mass", "seabed", "bending_ei",
-    "flow_inertia"])
+    "inv_mass", "node_length", "lines", "neighbours", "spring", "bending", "gravity", "buoyancy", "thrower",
+    "guides", "axial", "fluid_drag", "viscous_drag", "body_drag", "flow", "flow_push", "added_mass", "seabed",
+    "bending_ei", "flow_inertia"])
 """What the compiled code knows of the model's forces: 1 / m per node (N,), each node's share of unstretched
-length (N,) [m], and each term's parameters, in TERMS order (see each term's module for its layout)."""
+length (N,) [m], the lines' nodes (L, 2) (first, one past the last: :func:`ropesim.model.layout.line_table`),
+the nodes whose chord gives each node's tangent (2, N) (:func:`ropesim.model.forces.fluid.neighbours`), and
+each term's parameters, in TERMS order (see each term's module for its layout)."""
 
-Layout = namedtuple("Layout", ["mass", "held", "node_length"])
-"""What a term's ``params`` builder gets besides the scene: per-node mass [kg], held (bool) and length [m]."""
+Layout = namedtuple("Layout", ["mass", "held", "node_length", "lines"])
+"""What a term's ``params`` builder gets besides the scene: per-node mass [kg], held (bool) and length [m], and
+the lines (:class:`ropesim.model.layout.LineLayout`)."""
 
 
 def model_params(scene, layout: Layout) -> ModelParams:
     """Every term's parameters for ``scene`` (empty ones for the terms it does not switch on)."""
     values = [term.params(scene, layout) if term.declared(scene) else term.empty() for term in TERMS]
-    return ModelParams(1.0 / layout.mass, layout.node_length, *values)
+    n = len(layout.mass)
+    around = np.tile(np.arange(n, dtype=np.int64), (2, 1))   # a node on no line: its own neighbour, no tangent
+    for line in layout.lines:
+        around[:, line.first:line.end] = neighbours(line.first, line.nodes, line.closed)
+    return ModelParams(1.0 / layout.mass, layout.node_length, line_table(layout.lines), around, *values)
 
 
 def declared_terms(scene) -> tuple:
@@ -93,7 +102,7 @@ def switches(scene) -> jit.Switches:
     Newton matrix. :data:`WITH_MOTION` is the model's to add."""
     declared = declared_terms(scene)
     on = {term.switch.name for term in declared if term.switch is not None}
-    if scene.rope.closed:
+    if any(line.closed for line in line_layouts(scene)):
         on.add(WITH_WRAP_AROUND.name)
     if any(term.velocity for term in declared):
         on.add(WITH_VELOCITY_TERMS.name)
@@ -112,9 +121,12 @@ def position_accelerations(x, acc, p):
     """Overwrite ``acc`` (D, N) with the acceleration [m/s^2] of the terms that depend on positions alone.
     Inlined into its callers, as :func:`velocity_accelerations` is: a call hands over the whole parameter bundle
     by value, which cost rk4 20 % on a 21-node rope."""
-    closed = p.spring[2] != 0.0
     g = p.gravity[0] if WITH_GRAVITY else 0.0
-    set_chain_springs(x, acc, p.inv_mass, p.spring[0], p.spring[1], closed, g, p.spring[3] != 0.0)
+    for line in range(p.lines.shape[0]):
+        spring = p.spring[line]
+        set_chain_springs(x, acc, p.inv_mass, spring[0], spring[1], spring[2] != 0.0, g, spring[3] != 0.0,
+                          p.lines[line, 0], p.lines[line, 1])
+    closed = p.spring[0, 2] != 0.0   # a loop is a rope of one line (second-neighbour springs are a rope's too)
     if WITH_BENDING:
         add_pair_springs(x, acc, p.inv_mass, p.bending[0], p.bending[1], 2, closed)
     if WITH_BUOYANCY:
@@ -130,7 +142,6 @@ def velocity_accelerations(x, v, acc, p, t):
     """Add the acceleration [m/s^2] of the terms that depend on velocities or time (the thrower, the guides,
     axial damping, fluid forces, the accelerating water's, the seabed's damping and friction) at time t [s];
     returns the power [W] of the fluid, of the axial damping and of the seabed."""
-    closed = p.spring[2] != 0.0
     g = p.gravity[0] if WITH_GRAVITY else 0.0
     if WITH_THROWER:
         add_thrower(x, v, acc, p.inv_mass, p.thrower, g)
@@ -138,15 +149,18 @@ def velocity_accelerations(x, v, acc, p, t):
         add_guides(x, v, acc, p.guides, p.thrower, WITH_THROWER, g)
     internal = 0.0
     if WITH_AXIAL_DAMPING:
-        internal = add_axial_damping(x, v, acc, p.inv_mass, p.axial[0], closed)
+        for line in range(p.lines.shape[0]):
+            if p.axial[line] != 0.0:
+                internal += add_axial_damping(x, v, acc, p.inv_mass, p.axial[line], p.spring[line, 2] != 0.0,
+                                              p.lines[line, 0], p.lines[line, 1])
     fluid = 0.0
     if WITH_FLUID_DRAG or WITH_VISCOUS_DRAG or WITH_BODY_DRAG or WITH_FLOW_PUSH:
         fluid = add_fluid_forces(x, v, acc, p, t)
     if WITH_FLOW_INERTIA:
-        fluid += add_flow_inertia(x, v, acc, p.inv_mass, p.flow_inertia, p.flow, t, closed)
+        fluid += add_flow_inertia(x, v, acc, p.inv_mass, p.flow_inertia, p.flow, t, p.neighbours)
     seabed = 0.0
     if WITH_SEABED:
-        seabed = add_seabed_friction(x, v, acc, p.inv_mass, p.seabed, closed)
+        seabed = add_seabed_friction(x, v, acc, p.inv_mass, p.seabed, p.neighbours)
     return fluid, internal, seabed
 
 
@@ -163,7 +177,7 @@ def added_mass(x, v, acc, p):
     """With added mass on, turn ``acc`` (every force / m, drag included) into M^-1 F; returns the power [W] of
     the fluid's inertial force (0 without added mass)."""
     if WITH_ADDED_MASS:
-        return apply_added_mass(x, v, acc, p.added_mass, p.inv_mass, p.spring[2] != 0.0)
+        return apply_added_mass(x, v, acc, p.added_mass, p.inv_mass, p.neighbours)
     return 0.0
 
 
@@ -180,16 +194,18 @@ def applied_accelerations(x, v, out, p):
 
 
 @jit.kernel
-def _springs_energy_and_stretch(x, k, rest, stride, closed, slack):
+def _springs_energy_and_stretch(x, k, rest, stride, closed, slack, first, end):
+    """(energy [J], largest length / rest length, its first node) of the springs (i, i + stride) of the line
+    of nodes ``first`` .. ``end`` - 1."""
     dim, n = x.shape
-    count = n if closed else n - stride
+    count = end - first if closed else end - first - stride
     energy = 0.0
     worst = 0.0
     where = -1
-    for i in range(count):
+    for i in range(first, first + count):
         j = i + stride
-        if j >= n:
-            j -= n
+        if j >= end:
+            j -= end - first
         r2 = 0.0
         for d in range(dim):
             delta = x[d, j] - x[d, i]
@@ -209,10 +225,17 @@ def mechanical_energy(x, v, mass, p):
     its node). Checked every few steps by the run loop to catch a blow-up (runaway energy or an insane
     stretch)."""
     dim, n = x.shape
-    closed = p.spring[2] != 0.0
-    e, stretch, node = _springs_energy_and_stretch(x, p.spring[0], p.spring[1], 1, closed, p.spring[3] != 0.0)
+    e, stretch, node = 0.0, 0.0, -1
+    for line in range(p.lines.shape[0]):
+        spring = p.spring[line]
+        energy, worst, where = _springs_energy_and_stretch(x, spring[0], spring[1], 1, spring[2] != 0.0,
+                                                           spring[3] != 0.0, p.lines[line, 0], p.lines[line, 1])
+        e += energy
+        if not worst <= stretch:   # also catches NaN
+            stretch, node = worst, where
+    closed = p.spring[0, 2] != 0.0   # a loop is a rope of one line
     if WITH_BENDING:
-        e += _springs_energy_and_stretch(x, p.bending[0], p.bending[1], 2, closed, False)[0]
+        e += _springs_energy_and_stretch(x, p.bending[0], p.bending[1], 2, closed, False, 0, n)[0]
     if WITH_SEABED:
         e += seabed_energy(x, p.seabed)
     if WITH_EI_BENDING:
@@ -232,15 +255,21 @@ def mechanical_energy(x, v, mass, p):
 def coupling_jacobian(x, jac, beta, free, p):
     """Add the coupling terms' blocks for a stage of coefficient beta = gamma h: beta^2 times the springs' and
     bending's stiffness, beta times the axial damping."""
-    closed = p.spring[2] != 0.0
     scale = beta * beta
-    pair_spring_blocks(x, jac, p.spring[0], p.spring[1], 1, closed, scale, free, p.spring[3] != 0.0)
+    for line in range(p.lines.shape[0]):
+        spring = p.spring[line]
+        pair_spring_blocks(x, jac, spring[0], spring[1], 1, spring[2] != 0.0, scale, free, spring[3] != 0.0,
+                           p.lines[line, 0], p.lines[line, 1])
+    closed = p.spring[0, 2] != 0.0   # a loop is a rope of one line
     if WITH_BENDING:
-        pair_spring_blocks(x, jac, p.bending[0], p.bending[1], 2, closed, scale, free, False)
+        pair_spring_blocks(x, jac, p.bending[0], p.bending[1], 2, closed, scale, free, False, 0, x.shape[1])
     if WITH_AXIAL_DAMPING:
-        pair_damper_blocks(x, jac, p.axial[0], closed, beta, free)
+        for line in range(p.lines.shape[0]):
+            if p.axial[line] != 0.0:
+                pair_damper_blocks(x, jac, p.axial[line], p.spring[line, 2] != 0.0, beta, free, p.lines[line, 0],
+                                   p.lines[line, 1])
     if WITH_EI_BENDING:
-        add_ei_jacobian(x, jac, beta, free, p.bending_ei, p.spring[1], closed)
+        add_ei_jacobian(x, jac, beta, free, p.bending_ei, closed)
 
 
 @jit.kernel(inline="always")
@@ -254,7 +283,7 @@ def node_jacobian(x, v, band, beta, mass, free, p, t):
     if WITH_FLUID_DRAG or WITH_VISCOUS_DRAG or WITH_BODY_DRAG:
         add_fluid_jacobian(x, v, band, beta, free, p, t)
     if WITH_ADDED_MASS:
-        add_added_mass_jacobian(x, band, p.added_mass, free, p.spring[2] != 0.0)
+        add_added_mass_jacobian(x, band, p.added_mass, free, p.neighbours)
     if WITH_SEABED:
         add_seabed_jacobian(x, v, band, beta, free, p.seabed, True)
 

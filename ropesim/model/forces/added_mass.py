@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from . import Term
+from ..layout import line_volumes, per_node
 from .fluid import node_tangent
 from .. import jit
 
@@ -23,7 +24,7 @@ WITH_ADDED_MASS = jit.Switch("added_mass", "the fluid's added mass")
 
 
 @jit.kernel
-def apply_added_mass(x, v, acc, added, inv_mass, closed):
+def apply_added_mass(x, v, acc, added, inv_mass, around):
     """Turn ``acc`` (D, N), each node's F / m, into M^-1 F (see the module doc); returns the power [W] of the
     fluid's inertial force m a - F on the nodes moving at ``v``."""
     dim, n = x.shape
@@ -33,7 +34,7 @@ def apply_added_mass(x, v, acc, added, inv_mass, closed):
         if a_n == 0.0 and a_t == 0.0:
             continue
         m = 1.0 / inv_mass[i]
-        qx, qy, qz = node_tangent(x, i, closed)
+        qx, qy, qz = node_tangent(x, i, around)
         az = acc[2, i] if dim == 3 else 0.0
         along = acc[0, i] * qx + acc[1, i] * qy + az * qz          # F . q / m
         normal_scale = m / (m + a_n)
@@ -51,14 +52,14 @@ def apply_added_mass(x, v, acc, added, inv_mass, closed):
 
 
 @jit.kernel
-def add_added_mass_jacobian(x, band, added, free, closed):
+def add_added_mass_jacobian(x, band, added, free, around):
     """Add each free node's added-mass block A_i = a_n (I - q q^T) + a_t q q^T to the Newton matrix's band (the
     stiff integrator's residual carries M_i = m_i I + A_i; the tangent is frozen in this block)."""
     dim, n = x.shape
     for i in range(n):
         if not free[i] or (added[0, i] == 0.0 and added[1, i] == 0.0):
             continue
-        q = node_tangent(x, i, closed)
+        q = node_tangent(x, i, around)
         for a in range(dim):
             for b in range(a + 1):
                 qq = q[a] * q[b]
@@ -66,9 +67,9 @@ def add_added_mass_jacobian(x, band, added, free, closed):
 
 
 @jit.kernel
-def added_mass_times(x, i, w0, w1, w2, added, closed):
+def added_mass_times(x, i, w0, w1, w2, added, around):
     """A_i w for node i (the added-mass matrix times a vector (w0, w1, w2)), as a tuple."""
-    q = node_tangent(x, i, closed)
+    q = node_tangent(x, i, around)
     along = w0 * q[0] + w1 * q[1] + w2 * q[2]
     a_n, a_t = added[0, i], added[1, i]
     return (a_n * (w0 - along * q[0]) + a_t * along * q[0], a_n * (w1 - along * q[1]) + a_t * along * q[1],
@@ -76,11 +77,13 @@ def added_mass_times(x, i, w0, w1, w2, added, closed):
 
 
 def _params(scene, layout) -> np.ndarray:
-    added = np.zeros((2, len(layout.mass)))
+    n = len(layout.mass)
+    added = np.zeros((2, n))
     if scene.added_mass is not None:
-        rope_volume = math.pi * scene.rope.diameter ** 2 / 4.0 * layout.node_length
-        added[0] = scene.fluid.density * scene.added_mass.ca_normal * rope_volume
-        added[1] = scene.fluid.density * scene.added_mass.ca_tangential * rope_volume
+        rope_volume = line_volumes(layout.lines, layout.node_length)
+        added[0] = scene.fluid.density * per_node(layout.lines, n, [line.ca_normal for line in layout.lines]) * rope_volume
+        added[1] = scene.fluid.density * per_node(layout.lines, n, [line.ca_tangential for line in layout.lines]) \
+            * rope_volume
     for body in scene.bodies:
         if body.ca > 0:
             added[:, scene.node(body.node)] += scene.fluid.density * body.ca * body.volume

@@ -22,7 +22,9 @@ s = (1, -2, 1) over nodes i - 1, i, i + 1 and q the joint's tangent: positive se
 beam's bending stiffness is (its turning with the rope, and its dependence on stretch, are left out).
 
 Parameters: ``bending_ei`` = (C (N,) [N m], 0 where there is no joint; the clamps' directions (2, 3), row 0
-for node 0's and row 1 for the last node's, zero where the end is not clamped).
+for node 0's and row 1 for the last node's, zero where the end is not clamped; each node's segment length l
+(N,) [m]). A system's lines are joined end to end in the node arrays, but a line's end nodes carry C = 0 (no
+joint), so no joint spans two lines.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ import numpy as np
 
 from . import Term
 from ..jacobian import add_pair
+from ..layout import line_layouts, per_node
 from .. import jit
 
 WITH_EI_BENDING = jit.Switch("ei_bending", "bending stiffness EI")
@@ -52,7 +55,7 @@ def _joint(i, n, closed):
 @jit.kernel
 def add_ei_bending(x, acc, inv_mass, bending, closed):
     """Add the bending couple's accelerations [m/s^2] of every joint (see the module doc)."""
-    stiffness, clamps = bending
+    stiffness, clamps, segment = bending
     dim, n = x.shape
     for i in range(n):
         c = stiffness[i]
@@ -111,7 +114,7 @@ def _add_clamp(x, acc, inv_mass, c, u, end, next_node):
 @jit.kernel
 def ei_energy(x, bending, closed):
     """The bending energy, sum of C_i (1 - cos theta_i) [J] (a clamp's against its direction)."""
-    stiffness, clamps = bending
+    stiffness, clamps, segment = bending
     dim, n = x.shape
     e = 0.0
     for i in range(n):
@@ -141,11 +144,11 @@ def ei_energy(x, bending, closed):
 
 
 @jit.kernel
-def add_ei_jacobian(x, jac, beta, free, bending, rest, closed):
+def add_ei_jacobian(x, jac, beta, free, bending, closed):
     """Add beta^2 times the small-angle bending stiffness (see the module doc) to the Newton matrix ``jac``,
     as 2 pair(i-1, i) + 2 pair(i, i+1) - pair(i-1, i+1) of the block C_i / l^2 (I - q q^T); a clamp's, C / l^2
     (I - u u^T) on its end segment's far node."""
-    stiffness, clamps = bending
+    stiffness, clamps, segment = bending
     dim, n = x.shape
     blk = jac.blk
     for i in range(n):
@@ -156,7 +159,7 @@ def add_ei_jacobian(x, jac, beta, free, bending, rest, closed):
         if row >= 0:
             if free[hi]:
                 u = clamps[row]
-                scale = beta * beta * c / (rest * rest)
+                scale = beta * beta * c / (segment[i] * segment[i])
                 for a in range(dim):
                     for b in range(a + 1):
                         jac.band[a - b, hi * dim + b] += scale * ((1.0 if a == b else 0.0) - u[a] * u[b])
@@ -167,7 +170,7 @@ def add_ei_jacobian(x, jac, beta, free, bending, rest, closed):
         if ql > 0.0:
             q0, q1, q2 = q0 / ql, q1 / ql, q2 / ql
         q = (q0, q1, q2)
-        scale = beta * beta * c / (rest * rest)
+        scale = beta * beta * c / (segment[i] * segment[i])
         for weight, j, k in ((2.0, lo, i), (2.0, i, hi), (-1.0, lo, hi)):
             for a in range(dim):
                 for b in range(dim):
@@ -176,49 +179,59 @@ def add_ei_jacobian(x, jac, beta, free, bending, rest, closed):
 
 
 def _params(scene, layout) -> tuple:
-    """C_i = EI / l at every joint [N m], 2 EI / l at a clamped end, 0 at a free end; the clamps' directions."""
+    """C_i = EI / l at every joint of a line with EI [N m], 2 EI / l at a clamped end, 0 at a free end and off the
+    lines; the clamps' directions (a rope's); each node's segment length l [m]."""
     from ...scene.shapes import initial_positions
 
-    rope = scene.rope
-    c = np.full(rope.nodes, rope.EI / rope.segment_length)
+    n = len(layout.mass)
+    c = per_node(layout.lines, n, [line.EI / line.segment_length for line in layout.lines])
+    segment = per_node(layout.lines, n, [line.segment_length for line in layout.lines])
     clamps = np.zeros((2, 3))
-    if not rope.closed:
-        c[[0, -1]] = 0.0
+    for line in layout.lines:
+        if not line.closed:
+            c[[line.first, line.end - 1]] = 0.0
+    rope = scene.rope
+    for node in (scene.pinned.clamped or ()) if scene.pinned else ():
         x = initial_positions(scene)
-        for node in (scene.pinned.clamped or ()) if scene.pinned else ():
-            end = scene.node(node)
-            row, nxt = (0, 1) if end == 0 else (1, rope.nodes - 2)
-            direction = x[:, nxt] - x[:, end]
-            clamps[row, :scene.dimension] = direction / np.linalg.norm(direction)
-            c[end] = 2.0 * rope.EI / rope.segment_length
-    return c, clamps
+        end = scene.node(node)
+        row, nxt = (0, 1) if end == 0 else (1, rope.nodes - 2)
+        direction = x[:, nxt] - x[:, end]
+        clamps[row, :scene.dimension] = direction / np.linalg.norm(direction)
+        c[end] = 2.0 * rope.EI / rope.segment_length
+    return c, clamps, segment
 
 
 def _energy(model, x: np.ndarray) -> np.ndarray:
     """sum of C_i (1 - cos theta_i) [J] for frames x (..., N, D), a clamp's against its direction."""
     x = np.asarray(x)
-    c, clamps = model.params.bending_ei
-    closed = model.scene.rope.closed
-    a = x - np.roll(x, 1, axis=-2)
-    b = np.roll(x, -1, axis=-2) - x
-    cos = np.sum(a * b, axis=-1) / (np.linalg.norm(a, axis=-1) * np.linalg.norm(b, axis=-1))
-    if not closed:
-        dim = x.shape[-1]
-        cos[..., 0] = np.sum(clamps[0, :dim] * b[..., 0, :], axis=-1) / np.linalg.norm(b[..., 0, :], axis=-1)
-        cos[..., -1] = np.sum(clamps[1, :dim] * a[..., -1, :], axis=-1) / np.linalg.norm(a[..., -1, :], axis=-1)
-    return np.einsum("...n,n->...", 1.0 - cos, c)
+    c, clamps, _ = model.params.bending_ei
+    total = 0.0
+    for line in model.lines:
+        part = x[..., line.first:line.end, :]
+        a = part - np.roll(part, 1, axis=-2)
+        b = np.roll(part, -1, axis=-2) - part
+        with np.errstate(invalid="ignore", divide="ignore"):   # an end's wrapped chord: weighed by C = 0 below
+            cos = np.sum(a * b, axis=-1) / (np.linalg.norm(a, axis=-1) * np.linalg.norm(b, axis=-1))
+        if not line.closed:
+            dim = x.shape[-1]
+            cos[..., 0] = np.sum(clamps[0, :dim] * b[..., 0, :], axis=-1) / np.linalg.norm(b[..., 0, :], axis=-1)
+            cos[..., -1] = np.sum(clamps[1, :dim] * a[..., -1, :], axis=-1) / np.linalg.norm(a[..., -1, :], axis=-1)
+        weight = c[line.first:line.end]
+        total = total + np.einsum("...n,n->...", np.where(weight != 0.0, 1.0 - cos, 0.0), weight)
+    return total
 
 
 def _stiffness(model) -> float:
     """The bending's omega^2 bound, 16 C / (l^2 m) on the lightest free node [1/s^2] (a straight beam's
     zig-zag mode: the second difference's largest eigenvalue is 16)."""
     free = ~model.held
-    l0 = model.scene.rope.segment_length
-    c = model.params.bending_ei[0]
-    return float(np.max(16.0 * np.maximum(c, np.roll(c, 1))[free] / (l0 * l0 * model.mass[free]), initial=0.0))
+    c, _, l0 = model.params.bending_ei
+    with np.errstate(invalid="ignore", divide="ignore"):   # off the lines l = 0 and C = 0
+        rate = np.where(l0 > 0, 16.0 * np.maximum(c, np.roll(c, 1)) / (l0 * l0 * model.mass), 0.0)
+    return float(np.max(rate[free], initial=0.0))
 
 
-EI_TERM = Term("rope", WITH_EI_BENDING, _params, lambda: (np.zeros(0), np.zeros((2, 3))),
-               energy=_energy, node_stiffness=_stiffness, active=lambda scene: bool(scene.rope.EI), reach=2,
-               label="bending EI")
-"""The rope's bending stiffness EI (``rope.EI``)."""
+EI_TERM = Term("rope", WITH_EI_BENDING, _params, lambda: (np.zeros(0), np.zeros((2, 3)), np.zeros(0)),
+               energy=_energy, node_stiffness=_stiffness,
+               active=lambda scene: any(line.EI for line in line_layouts(scene)), reach=2, label="bending EI")
+"""The lines' bending stiffness EI (``rope.EI``, a line's ``EI``)."""

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from . import Term
+from ..layout import line_volumes
 from .. import jit
 
 WITH_BUOYANCY = jit.Switch("buoyancy", "buoyancy")
@@ -24,16 +25,16 @@ def add_buoyancy(acc, up):
         acc[1, i] += up[i]
 
 
-def displaced_volume(scene, node_length: np.ndarray) -> np.ndarray:
-    """Each node's displaced volume [m^3]: its share of the rope's and its body's."""
-    volume = math.pi * scene.rope.diameter ** 2 / 4.0 * node_length
+def displaced_volume(scene, layout) -> np.ndarray:
+    """Each node's displaced volume [m^3]: its share of its line's and its body's."""
+    volume = line_volumes(layout.lines, layout.node_length)
     for body in scene.bodies:
         volume[scene.node(body.node)] += body.volume
     return volume
 
 
 def _params(scene, layout) -> np.ndarray:
-    return scene.fluid.density * displaced_volume(scene, layout.node_length) * scene.gravity.g / layout.mass
+    return scene.fluid.density * displaced_volume(scene, layout) * scene.gravity.g / layout.mass
 
 
 def buoyancy_energy(model, x: np.ndarray) -> np.ndarray:

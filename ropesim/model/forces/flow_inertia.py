@@ -47,7 +47,7 @@ def ramp_rate(t, ramp_time):
 
 
 @jit.kernel
-def add_flow_inertia(x, v, acc, inv_mass, inertia, flow, t, closed):
+def add_flow_inertia(x, v, acc, inv_mass, inertia, flow, t, around):
     """Add the accelerating water's force (see the module doc) at time t [s] as accelerations [m/s^2]; returns
     its power [W] on the nodes moving at ``v``."""
     scalars, table = flow
@@ -61,7 +61,7 @@ def add_flow_inertia(x, v, acc, inv_mass, inertia, flow, t, closed):
         if k_n == 0.0 and k_t == 0.0:
             continue
         ax, ay, az = flow_scaled(x[1, i], rate, scalars, table)
-        qx, qy, qz = node_tangent(x, i, closed)
+        qx, qy, qz = node_tangent(x, i, around)
         along = ax * qx + ay * qy + az * qz
         fx = k_n * (ax - along * qx) + k_t * along * qx
         fy = k_n * (ay - along * qy) + k_t * along * qy
@@ -78,7 +78,7 @@ def add_flow_inertia(x, v, acc, inv_mass, inertia, flow, t, closed):
 def _params(scene, layout) -> np.ndarray:
     k = np.zeros((2, len(layout.mass)))
     if scene.buoyancy is not None:
-        k += scene.fluid.density * displaced_volume(scene, layout.node_length)
+        k += scene.fluid.density * displaced_volume(scene, layout)
     if ADDED_MASS_TERM.declared(scene):
         k += added_mass_params(scene, layout)
     k[:, layout.held] = 0.0

@@ -19,7 +19,7 @@ Lumping: every coefficient acts on the node's share L of *unstretched* length, a
 changes neither mass nor drag area). A node whose two neighbours coincide has no tangent: all of u counts as
 normal. All of it is work of the fluid, booked in the energy ledger's ``fluid_work``.
 
-Parameters: ``fluid_drag`` [c_n, c_t] [kg/m^2], ``viscous_drag`` [b_n, b_t] [N s/m^2], ``body_drag`` (N,)
+Parameters: ``fluid_drag`` (2, N) c_n and c_t per node [kg/m^2] (each line's own), ``viscous_drag`` [b_n, b_t] [N s/m^2], ``body_drag`` (N,)
 rho CdA / 2 [kg/m], ``flow_push`` (N,) b / m [1/s], ``flow`` = (scalars [profile, ramp_time, datum,
 reference_height, exponent, Ux, Uy, Uz], table (K, 4) [y, Ux, Uy, Uz]), and the model's ``node_length`` (N,).
 """
@@ -31,6 +31,7 @@ import math
 import numpy as np
 
 from . import Term
+from ..layout import per_node
 from .. import jit
 
 WITH_FLUID_DRAG = jit.Switch("fluid_drag", "Morison quadratic drag")
@@ -87,15 +88,24 @@ def flow_scaled(y, s, flow, table):
     return s * flow[5], s * flow[6], s * flow[7]
 
 
-@jit.kernel(inline="always")
-def node_tangent(x, i, closed):
-    """The unit tangent (qx, qy, qz) of node i (see the module doc); (0, 0, 0) when it has none."""
-    dim, n = x.shape
+def neighbours(first: int, nodes: int, closed: bool) -> np.ndarray:
+    """The nodes (2, nodes) whose chord gives each node's tangent, for a line of ``nodes`` nodes from node
+    ``first``: its two neighbours; at an open line's end itself and its one neighbour (the end segment's
+    direction); round a loop the wrapped ones. A node on no line (a free point) is its own neighbour both ways,
+    so it has no tangent. ``ModelParams.neighbours`` holds them for every node."""
+    i = np.arange(nodes)
     lo, hi = i - 1, i + 1
-    if lo < 0:
-        lo = n - 1 if closed else 0
-    if hi >= n:
-        hi = 0 if closed else n - 1
+    lo[0] = nodes - 1 if closed else 0
+    hi[-1] = 0 if closed else nodes - 1
+    return np.stack([lo, hi]).astype(np.int64) + first
+
+
+@jit.kernel(inline="always")
+def node_tangent(x, i, around):
+    """The unit tangent (qx, qy, qz) of node i (see the module doc), along the chord between its neighbours
+    ``around[:, i]`` (:func:`neighbours`); (0, 0, 0) when it has none."""
+    dim = x.shape[0]
+    lo, hi = around[0, i], around[1, i]
     qx = x[0, hi] - x[0, lo]
     qy = x[1, hi] - x[1, lo]
     qz = x[2, hi] - x[2, lo] if dim == 3 else 0.0
@@ -110,8 +120,7 @@ def add_fluid_forces(x, v, acc, p, t):
     """Add the fluid forces (see the module doc) of every free-or-held node as accelerations [m/s^2]; returns
     their power [W] on the rope (held nodes included: their supports take it)."""
     dim, n = x.shape
-    closed = p.spring[2] != 0.0
-    c_n, c_t = p.fluid_drag[0], p.fluid_drag[1]
+    c_n, c_t = p.fluid_drag[0], p.fluid_drag[1]   # per node
     b_n, b_t = p.viscous_drag[0], p.viscous_drag[1]
     flow, table = p.flow
     power = 0.0
@@ -124,14 +133,14 @@ def add_fluid_forces(x, v, acc, p, t):
         rz = v[2, i] - uz if dim == 3 else 0.0
         fx = fy = fz = 0.0
         if WITH_FLUID_DRAG or WITH_VISCOUS_DRAG:
-            qx, qy, qz = node_tangent(x, i, closed)
+            qx, qy, qz = node_tangent(x, i, p.neighbours)
             along = rx * qx + ry * qy + rz * qz
             tx, ty, tz = along * qx, along * qy, along * qz
             nx, ny, nz = rx - tx, ry - ty, rz - tz
             length = p.node_length[i]
             if WITH_FLUID_DRAG:
-                cn = c_n * length * math.sqrt(nx * nx + ny * ny + nz * nz)
-                ct = c_t * length * abs(along)
+                cn = c_n[i] * length * math.sqrt(nx * nx + ny * ny + nz * nz)
+                ct = c_t[i] * length * abs(along)
                 fx -= cn * nx + ct * tx
                 fy -= cn * ny + ct * ty
                 fz -= cn * nz + ct * tz
@@ -168,9 +177,8 @@ def add_fluid_jacobian(x, v, band, beta, free, p, t):
     L (b_n P + b_t q q^T); a body c_b (|u| I + |u| r r^T) (r = u / |u|). All positive semi-definite.
     """
     dim, n = x.shape
-    closed = p.spring[2] != 0.0
     flow, table = p.flow
-    c_n, c_t = p.fluid_drag[0], p.fluid_drag[1]
+    c_n, c_t = p.fluid_drag[0], p.fluid_drag[1]   # per node
     b_n, b_t = p.viscous_drag[0], p.viscous_drag[1]
     for i in range(n):
         if not free[i]:
@@ -183,7 +191,7 @@ def add_fluid_jacobian(x, v, band, beta, free, p, t):
         nv = (0.0, 0.0, 0.0)
         along = speed_n = length = 0.0
         if WITH_FLUID_DRAG or WITH_VISCOUS_DRAG:
-            q = node_tangent(x, i, closed)
+            q = node_tangent(x, i, p.neighbours)
             along = r[0] * q[0] + r[1] * q[1] + r[2] * q[2]
             nv = (r[0] - along * q[0], r[1] - along * q[1], r[2] - along * q[2])
             speed_n = math.sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2])
@@ -196,9 +204,9 @@ def add_fluid_jacobian(x, v, band, beta, free, p, t):
                 qq = q[a] * q[b]
                 c = 0.0
                 if WITH_FLUID_DRAG:
-                    c += c_n * length * speed_n * (unit - qq) + 2.0 * c_t * length * abs(along) * qq
+                    c += c_n[i] * length * speed_n * (unit - qq) + 2.0 * c_t[i] * length * abs(along) * qq
                     if speed_n > 0.0:
-                        c += c_n * length * nv[a] * nv[b] / speed_n
+                        c += c_n[i] * length * nv[a] * nv[b] / speed_n
                 if WITH_VISCOUS_DRAG:
                     c += length * (b_n * (unit - qq) + b_t * qq)
                 if speed > 0.0:
@@ -220,18 +228,13 @@ def add_fluid_tangent_stiffness(x, v, blocks, free, p, t):
     held columns.
     """
     dim, n = x.shape
-    closed = p.spring[2] != 0.0
     flow, table = p.flow
-    c_n, c_t = p.fluid_drag[0], p.fluid_drag[1]
+    c_n, c_t = p.fluid_drag[0], p.fluid_drag[1]   # per node
     b_n, b_t = p.viscous_drag[0], p.viscous_drag[1]
     for i in range(n):
         if not free[i]:
             continue
-        lo, hi = i - 1, i + 1
-        if lo < 0:
-            lo = n - 1 if closed else 0
-        if hi >= n:
-            hi = 0 if closed else n - 1
+        lo, hi = p.neighbours[0, i], p.neighbours[1, i]
         e0, e1 = x[0, hi] - x[0, lo], x[1, hi] - x[1, lo]
         e2 = x[2, hi] - x[2, lo] if dim == 3 else 0.0
         r = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
@@ -245,8 +248,8 @@ def add_fluid_tangent_stiffness(x, v, blocks, free, p, t):
         a = u[0] * q[0] + u[1] * q[1] + u[2] * q[2]
         un = (u[0] - a * q[0], u[1] - a * q[1], u[2] - a * q[2])
         sn = math.sqrt(un[0] * un[0] + un[1] * un[1] + un[2] * un[2])
-        cn = c_n * p.node_length[i] if WITH_FLUID_DRAG else 0.0
-        ct = c_t * p.node_length[i] if WITH_FLUID_DRAG else 0.0
+        cn = c_n[i] * p.node_length[i] if WITH_FLUID_DRAG else 0.0
+        ct = c_t[i] * p.node_length[i] if WITH_FLUID_DRAG else 0.0
         lin = p.node_length[i] * (b_n - b_t) if WITH_VISCOUS_DRAG else 0.0
         before = 0 if lo != i else 1
         after = 2 if hi != i else 1
@@ -293,13 +296,16 @@ def _free_min_mass(model) -> float:
 def _quadratic_rate(model) -> float:
     """Largest d(drag force)/d(speed) / mass [1/s] of the quadratic drag at the speed scale: 2 c L U / m."""
     p, free = model.params, ~model.held
-    c = max(p.fluid_drag[0], p.fluid_drag[1])
-    return float(np.max(2.0 * c * p.node_length[free] * speed_scale(model) / model.mass[free], initial=0.0))
+    c = np.maximum(p.fluid_drag[0], p.fluid_drag[1])
+    return float(np.max(2.0 * c[free] * p.node_length[free] * speed_scale(model) / model.mass[free], initial=0.0))
 
 
 def _fluid_drag(scene, layout) -> np.ndarray:
-    rho, d = scene.fluid.density, scene.rope.diameter
-    return np.array([0.5 * rho * scene.fluid_drag.cd_normal * d, 0.5 * rho * scene.fluid_drag.cd_tangential * math.pi * d])
+    """(2, N): c_n = rho Cd_n d / 2 and c_t = rho Cd_t pi d / 2 of each node's line [kg/m^2] (0 off the lines)."""
+    rho, n = scene.fluid.density, len(layout.mass)
+    return np.stack([per_node(layout.lines, n, [0.5 * rho * line.cd_normal * line.diameter for line in layout.lines]),
+                     per_node(layout.lines, n, [0.5 * rho * line.cd_tangential * math.pi * line.diameter
+                                                for line in layout.lines])])
 
 
 def _body_drag(scene, layout) -> np.ndarray:
@@ -333,7 +339,7 @@ def _flow_push(scene, layout) -> np.ndarray:
     return np.where(layout.held, 0.0, b / layout.mass)
 
 
-FLUID_DRAG_TERM = Term("fluid_drag", WITH_FLUID_DRAG, _fluid_drag, lambda: np.zeros(2), damping=_quadratic_rate,
+FLUID_DRAG_TERM = Term("fluid_drag", WITH_FLUID_DRAG, _fluid_drag, lambda: np.zeros((2, 0)), damping=_quadratic_rate,
                        ledger="fluid", velocity=True)
 VISCOUS_DRAG_TERM = Term(
     "viscous_drag", WITH_VISCOUS_DRAG, lambda scene, layout: np.array([scene.viscous_drag.b_normal,

@@ -10,8 +10,8 @@ delta = -s. On its footprint A = contact_width x L (L its share of unstretched l
   MoorDyn's cBot), none while it moves out: the seabed resists being pressed but never holds a node back
   (MoorDyn damps both ways, which makes its seabed sticky: a node lifting off at 0.1 m/s is held by c A v, for
   a 10 cm chain's 3 m node 10 kN, while it rises through its millimetre of sink). f = min(1, delta / delta_d)
-  grows it over the first delta_d = 1e-3 times the footprint's width of penetration (0.1 mm for a 10 cm
-  chain, less than what it sinks under its own weight), so that the contact force has no jump where a moving
+  grows it over the first delta_d = 1e-3 times the footprint's width of penetration (the widest line's in a
+  system; 0.1 mm for a 10 cm chain, less than what it sinks under its own weight), so that the contact force has no jump where a moving
   node touches the plane. Both choices keep the normal force continuous and growing with depth, which the
   stiff method's Newton solve needs (a force that jumps may leave a stage equation without a root). With
   ``damping_both_ways`` (for equal physics with MoorDyn) the damping is MoorDyn's instead: -c (v . n) A along
@@ -35,6 +35,7 @@ import math
 import numpy as np
 
 from . import Term
+from ..layout import per_node
 from .fluid import node_tangent
 from .. import jit
 
@@ -64,7 +65,7 @@ def add_seabed_contact(x, acc, inv_mass, seabed):
 
 
 @jit.kernel
-def add_seabed_friction(x, v, acc, inv_mass, seabed, closed):
+def add_seabed_friction(x, v, acc, inv_mass, seabed, around):
     """Add the contact damping and friction (see the module doc) as accelerations; returns their power [W]."""
     bed, area = seabed
     dim, n = x.shape
@@ -86,7 +87,7 @@ def add_seabed_friction(x, v, acc, inv_mass, seabed, closed):
         fz = 0.0
         if mu > 0.0 or mu_axial > 0.0:
             sx, sy, sz = v[0, i] - vn * nx, v[1, i] - vn * ny, vz   # sliding velocity, in the plane
-            qx, qy, qz = node_tangent(x, i, closed)
+            qx, qy, qz = node_tangent(x, i, around)
             qn = qx * nx + qy * ny
             tx, ty, tz = qx - qn * nx, qy - qn * ny, qz
             tl = math.sqrt(tx * tx + ty * ty + tz * tz)
@@ -159,10 +160,12 @@ def add_seabed_jacobian(x, v, band, beta, free, seabed, friction):
 def _params(scene, layout) -> tuple:
     bed = scene.seabed
     a = math.radians(bed.slope)
-    width = bed.contact_width if bed.contact_width is not None else scene.rope.diameter
+    n = len(layout.mass)
+    width = (np.full(n, bed.contact_width) if bed.contact_width is not None
+             else per_node(layout.lines, n, [line.diameter or 0.0 for line in layout.lines]))
     scalars = np.array([bed.height, math.tan(a), math.cos(a), math.sin(a), bed.stiffness, bed.damping, bed.friction,
                         bed.friction if bed.friction_axial is None else bed.friction_axial, bed.friction_speed,
-                        DAMPING_DEPTH * width, 1.0 if bed.damping_both_ways else 0.0])
+                        DAMPING_DEPTH * float(width.max(initial=0.0)), 1.0 if bed.damping_both_ways else 0.0])
     return scalars, width * layout.node_length
 
 

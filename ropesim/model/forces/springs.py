@@ -14,6 +14,7 @@ The rope's parameters: k [N/m], l0 [m], closed (1 or 0), slack (1: no compressio
 import numpy as np
 
 from . import Term
+from ..layout import line_layouts
 from .. import jit
 
 WITH_AXIAL_DAMPING = jit.Switch("axial_damping", "the segments' axial damping")
@@ -55,63 +56,72 @@ def _spring_scale(k, rest, r2, slack):
     return c
 
 
+ONE = np.uint64(1)   # the line kernels index with unsigned integers: see set_chain_springs
+
+
 @jit.kernel
-def set_chain_springs(x, acc, inv_mass, k, rest, closed, g, slack):
-    """Overwrite ``acc`` with the accelerations [m/s^2] of the rope's springs (i, i + 1), minus ``g`` along y.
+def set_chain_springs(x, acc, inv_mass, k, rest, closed, g, slack, a, b):
+    """Overwrite ``acc`` with the accelerations [m/s^2] of the springs (i, i + 1) of the line of nodes a .. b - 1,
+    minus ``g`` along y.
 
     The same forces as ``add_pair_springs(..., stride=1, ...)`` plus gravity, computed so that both loops
     vectorise: first each spring's force F_i (on node i, from spring (i, i + 1)) is written into ``acc[:, i]``,
-    then, from the last node down, a_i = (F_i - F_(i-1)) / m_i - g. 2-D and 3-D are written out row by row.
+    then, from the last node down, a_i = (F_i - F_(i-1)) / m_i - g. 2-D and 3-D are written out row by row. The
+    node indices are unsigned: a signed index that Numba cannot prove non-negative gets a wrap-around test
+    (Python's negative indexing) that stops the loops vectorising, twice as slow from a few hundred nodes.
     """
-    dim, n = x.shape
+    dim = x.shape[0]
+    first, last = np.uint64(a), np.uint64(b) - ONE
     if dim == 2:
-        for i in range(n - 1):
-            d0 = x[0, i + 1] - x[0, i]
-            d1 = x[1, i + 1] - x[1, i]
+        for i in range(first, last):
+            d0 = x[0, i + ONE] - x[0, i]
+            d1 = x[1, i + ONE] - x[1, i]
             c = _spring_scale(k, rest, d0 * d0 + d1 * d1, slack)
             acc[0, i] = c * d0
             acc[1, i] = c * d1
-        l0 = l1 = 0.0   # the force of the spring closing a loop, (n - 1, 0), on node n - 1
+        l0 = l1 = 0.0   # the force of the spring closing a loop, (last, first), on node last
         if closed:
-            d0 = x[0, 0] - x[0, n - 1]
-            d1 = x[1, 0] - x[1, n - 1]
+            d0 = x[0, first] - x[0, last]
+            d1 = x[1, first] - x[1, last]
             c = _spring_scale(k, rest, d0 * d0 + d1 * d1, slack)
             l0, l1 = c * d0, c * d1
-        acc[0, n - 1] = l0
-        acc[1, n - 1] = l1
-        for i in range(n - 1, 0, -1):
+        acc[0, last] = l0
+        acc[1, last] = l1
+        for back in range(last - first):
+            i = last - np.uint64(back)
             m = inv_mass[i]
-            acc[0, i] = (acc[0, i] - acc[0, i - 1]) * m
-            acc[1, i] = (acc[1, i] - acc[1, i - 1]) * m - g
-        acc[0, 0] = (acc[0, 0] - l0) * inv_mass[0]
-        acc[1, 0] = (acc[1, 0] - l1) * inv_mass[0] - g
+            acc[0, i] = (acc[0, i] - acc[0, i - ONE]) * m
+            acc[1, i] = (acc[1, i] - acc[1, i - ONE]) * m - g
+        acc[0, first] = (acc[0, first] - l0) * inv_mass[first]
+        acc[1, first] = (acc[1, first] - l1) * inv_mass[first] - g
     else:
-        for i in range(n - 1):
-            d0 = x[0, i + 1] - x[0, i]
-            d1 = x[1, i + 1] - x[1, i]
-            d2 = x[2, i + 1] - x[2, i]
+        for i in range(first, last):
+            d0 = x[0, i + ONE] - x[0, i]
+            d1 = x[1, i + ONE] - x[1, i]
+            d2 = x[2, i + ONE] - x[2, i]
             c = _spring_scale(k, rest, d0 * d0 + d1 * d1 + d2 * d2, slack)
             acc[0, i] = c * d0
             acc[1, i] = c * d1
             acc[2, i] = c * d2
         l0 = l1 = l2 = 0.0
         if closed:
-            d0 = x[0, 0] - x[0, n - 1]
-            d1 = x[1, 0] - x[1, n - 1]
-            d2 = x[2, 0] - x[2, n - 1]
+            d0 = x[0, first] - x[0, last]
+            d1 = x[1, first] - x[1, last]
+            d2 = x[2, first] - x[2, last]
             c = _spring_scale(k, rest, d0 * d0 + d1 * d1 + d2 * d2, slack)
             l0, l1, l2 = c * d0, c * d1, c * d2
-        acc[0, n - 1] = l0
-        acc[1, n - 1] = l1
-        acc[2, n - 1] = l2
-        for i in range(n - 1, 0, -1):
+        acc[0, last] = l0
+        acc[1, last] = l1
+        acc[2, last] = l2
+        for back in range(last - first):
+            i = last - np.uint64(back)
             m = inv_mass[i]
-            acc[0, i] = (acc[0, i] - acc[0, i - 1]) * m
-            acc[1, i] = (acc[1, i] - acc[1, i - 1]) * m - g
-            acc[2, i] = (acc[2, i] - acc[2, i - 1]) * m
-        acc[0, 0] = (acc[0, 0] - l0) * inv_mass[0]
-        acc[1, 0] = (acc[1, 0] - l1) * inv_mass[0] - g
-        acc[2, 0] = (acc[2, 0] - l2) * inv_mass[0]
+            acc[0, i] = (acc[0, i] - acc[0, i - ONE]) * m
+            acc[1, i] = (acc[1, i] - acc[1, i - ONE]) * m - g
+            acc[2, i] = (acc[2, i] - acc[2, i - ONE]) * m
+        acc[0, first] = (acc[0, first] - l0) * inv_mass[first]
+        acc[1, first] = (acc[1, first] - l1) * inv_mass[first] - g
+        acc[2, first] = (acc[2, first] - l2) * inv_mass[first]
 
 
 BLOCK_BYTES = 16 * 2 ** 20   # the NumPy helpers below work on at most this many bytes of positions at a time
@@ -174,13 +184,16 @@ def segment_forces(model, x, v) -> np.ndarray:
 
 
 @jit.kernel
-def add_axial_damping(x, v, acc, inv_mass, c, closed):
-    """Add the segments' axial damping c (r_hat . dv) r_hat [N] / m; returns its power [W] (never positive)."""
-    dim, n = x.shape
-    count = n if closed else n - 1
+def add_axial_damping(x, v, acc, inv_mass, c, closed, a, b):
+    """Add the axial damping c (r_hat . dv) r_hat [N] / m of the segments of the line of nodes a .. b - 1;
+    returns its power [W] (never positive)."""
+    dim = x.shape[0]
+    first, end = np.uint64(a), np.uint64(b)
+    count = end - first if closed else end - first - ONE
     power = 0.0
-    for i in range(count):
-        j = i + 1 if i + 1 < n else 0
+    for s in range(count):
+        i = first + np.uint64(s)
+        j = i + ONE if i + ONE < end else first
         r2 = 0.0
         rate = 0.0
         for d in range(dim):
@@ -198,29 +211,43 @@ def add_axial_damping(x, v, acc, inv_mass, c, closed):
     return power
 
 
-def _rope_params(scene, mass) -> np.ndarray:
-    rope = scene.rope
-    return np.array([rope.stiffness, rope.segment_length, 1.0 if rope.closed else 0.0,
-                     0.0 if rope.compression else 1.0])
+def _rope_params(scene, layout) -> np.ndarray:
+    """(L, 4): each line's k [N/m], rest length l [m], closed (1) or open (0), slack (1) or not (0)."""
+    return np.array([[line.stiffness, line.segment_length, 1.0 if line.closed else 0.0, 1.0 if line.slack else 0.0]
+                     for line in layout.lines])
 
 
 def _bending_params(scene, mass) -> np.ndarray:
     return np.array([scene.bending.stiffness, 2.0 * scene.rope.segment_length])
 
 
+def _lines_energy(model, x) -> np.ndarray:
+    """Every line's springs' energy [J] for frames x (..., N, D)."""
+    x = np.asarray(x)
+    return sum(pair_spring_energy(x[..., line.first:line.end, :], line.stiffness, line.segment_length, 1, line.closed,
+                                  line.slack) for line in model.lines)
+
+
+def _axial_rate(model) -> float:
+    """The fastest axial damping rate 4 c / m [1/s] on a line's lightest free node, c = BA / l."""
+    rates = [4.0 * line.axial_damping / line.segment_length / float(mass.min())
+             for line in model.lines if line.axial_damping
+             for mass in [model.mass[line.first:line.end][~model.held[line.first:line.end]]] if mass.size]
+    return max(rates, default=0.0)
+
+
 ROPE = Term(
-    "rope", None, _rope_params, lambda: np.zeros(4),
-    energy=lambda model, x: pair_spring_energy(x, model.scene.rope.stiffness, model.scene.rope.segment_length, 1,
-                                               model.scene.rope.closed, not model.scene.rope.compression),
-    springs=lambda model: [(1, model.scene.rope.stiffness)], label="spring", reach=1)
-"""The rope's own springs (i, i + 1): parameters k [N/m], rest length l [m], closed (1) or open (0), slack (1)."""
+    "rope", None, _rope_params, lambda: np.zeros((1, 4)), energy=_lines_energy,
+    springs=lambda model: [(1, max(line.stiffness for line in model.lines))], label="spring", reach=1)
+"""The lines' own springs (i, i + 1): parameters per line, k [N/m], rest length l [m], closed (1) or open (0),
+slack (1)."""
 
 AXIAL_DAMPING = Term(
-    "rope", WITH_AXIAL_DAMPING, lambda scene, mass: np.array([scene.rope.axial_damping / scene.rope.segment_length]),
-    lambda: np.zeros(1), active=lambda scene: bool(scene.rope.axial_damping),
-    damping=lambda model: 4.0 * model.scene.rope.axial_damping / model.scene.rope.segment_length
-    / float(model.mass[~model.held].min()), ledger="internal", velocity=True)
-"""The segments' internal damping: parameter c = BA / l [N s/m]."""
+    "rope", WITH_AXIAL_DAMPING,
+    lambda scene, layout: np.array([line.axial_damping / line.segment_length for line in layout.lines]),
+    lambda: np.zeros(1), active=lambda scene: any(line.axial_damping for line in line_layouts(scene)),
+    damping=_axial_rate, ledger="internal", velocity=True)
+"""The segments' internal damping: parameter c = BA / l [N s/m] per line (0 on a line without)."""
 
 BENDING = Term(
     "bending", WITH_BENDING, _bending_params, lambda: np.zeros(2),
