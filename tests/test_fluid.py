@@ -22,7 +22,7 @@ from ropesim.analysis.accuracy import observed_order, run_once
 from ropesim.integrate.health import FLUID, INTERNAL
 from ropesim.integrate.methods import METHODS
 from ropesim.model.build import build
-from ropesim.model.terms import accelerations, added_mass
+from ropesim.model.terms import accelerations, solve_accelerations
 from ropesim.scene.loader import SceneError
 
 from references.closed_forms import drop_quadratic, rope_terminal_velocity
@@ -228,7 +228,7 @@ def test_added_mass_solves_the_mass_matrix_equation(seed, dim):
     v = rng.normal(size=(dim, n))
     force = rng.normal(size=(dim, n))
     acc = force / model.mass
-    power = model.kernel(added_mass)(x, v, acc, model.params)
+    power = model.kernel(solve_accelerations)(x, v, acc, model.params)
     volume = math.pi * 0.05 ** 2 / 4 * np.where(np.arange(n) % (n - 1) == 0, 0.5, 1.0)
     for i in range(n):
         lo, hi = max(i - 1, 0), min(i + 1, n - 1)

@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.terms import WITH_ADDED_MASS, WITH_APPLIED, accelerations, added_mass, applied_accelerations
+from ..model.junctions import WITH_JUNCTIONS
+from ..model.terms import WITH_ADDED_MASS, WITH_APPLIED, accelerations, applied_accelerations, solve_accelerations
 from .base import Integrator, Method
 from .health import BOX, DRAG, FLUID, HELD, INTERNAL, OK, SEABED, due, end_step, held_power, place, power
 from ..model import jit
@@ -165,8 +166,8 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
                     kx[st, d, i] = vs[d, i]
                     kv[st, d, i] = acc[d, i] - gamma[i] * vs[d, i]
                     lost += gamma[i] * mass[i] * vs[d, i] * vs[d, i]
-            if WITH_ADDED_MASS:
-                fluid += added_mass(xs, vs, kv[st], params)
+            if WITH_ADDED_MASS or WITH_JUNCTIONS:
+                fluid += solve_accelerations(xs, vs, kv[st], params)
             for j in range(held_idx.shape[0]):
                 for d in range(dim):
                     kv[st, d, held_idx[j]] = 0.0

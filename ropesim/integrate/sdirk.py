@@ -31,8 +31,8 @@ import numpy as np
 
 from ..model.jacobian import Jacobian, band_width
 from ..model.forces.added_mass import added_mass_times
-from ..model.terms import (WITH_ADDED_MASS, WITH_APPLIED, accelerations, added_mass, applied_accelerations,
-                           coupling_reach, newton_matrix)
+from ..model.terms import (WITH_ADDED_MASS, WITH_APPLIED, accelerations, applied_accelerations, coupling_reach,
+                           newton_matrix, solve_accelerations)
 from ..model.banded import factor, solve, woodbury
 from .base import Integrator, Method
 from .health import BOX, DRAG, FLUID, HELD, INTERNAL, NEWTON_FAILED, OK, SEABED, due, end_step, held_power, place, power
@@ -278,7 +278,7 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
                 for d in range(dim):
                     for i in range(n):
                         tmp[d, i] = acc[d, i] - drag[i] * V[d, i] / mass[i]
-                fluid += added_mass(X, V, tmp, params)
+                fluid += solve_accelerations(X, V, tmp, params)
             ledger[FLUID] += weight * fluid
             ledger[INTERNAL] += weight * internal
             ledger[SEABED] += weight * seabed

@@ -20,7 +20,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..model.terms import WITH_APPLIED, added_mass, applied_accelerations, velocity_accelerations
+from ..model.terms import WITH_APPLIED, applied_accelerations, solve_accelerations, velocity_accelerations
 from ..model import jit
 
 RK4_A = (0.0, 0.5, 0.5, 1.0)          # each sub-stage's offset along the kick, as a fraction of tau
@@ -67,7 +67,7 @@ def velocity_kick(x, v, acc_x, tau, t, params, mass, gamma, held, scratch):
             for i in range(n):
                 a[d, i] -= gamma[i] * y[d, i]
                 p_drag += gamma[i] * mass[i] * y[d, i] * y[d, i]
-        p_fluid += added_mass(x, y, a, params)
+        p_fluid += solve_accelerations(x, y, a, params)
         p_box = 0.0
         if WITH_APPLIED:
             applied_accelerations(x, y, a_box, params)

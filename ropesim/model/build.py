@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..scene import schema as S
-from ..scene.shapes import initial_positions
-from .layout import LineLayout, line_layouts, node_lengths
+from ..scene.shapes import initial_positions, sagging_line
+from .layout import LineLayout, line_layouts, lumped_bodies, node_lengths, point_ends
 from .motion import Motion, motion_of
 from . import jit
 from .terms import WITH_APPLIED, WITH_MOTION, WITH_VELOCITY_TERMS, Layout, ModelParams, model_params, switches
@@ -85,10 +85,52 @@ class Model:
                                                                                      for g in scene.guides)
 
 
+@dataclass
+class Nodes:
+    """What a scene's form decides of its nodes (a rope's, :func:`_rope_nodes`; a system's,
+    :func:`_system_nodes`); :func:`build` makes the model from it. Arrays over the N nodes."""
+
+    x0: np.ndarray        # (D, N) initial positions [m]
+    v0: np.ndarray        # (D, N) initial velocities [m/s]
+    mass: np.ndarray      # (N,) [kg]
+    drag: np.ndarray      # (N,) linear drag b [kg/s]
+    held_v: np.ndarray    # (D, N) the held nodes' constant velocities [m/s]
+    held: np.ndarray      # (N,) bool
+    drives: list          # (node indices, drive) of the held nodes' prescribed motions (model/motion.py)
+
+
 def build(scene: S.Scene, solve: bool = True) -> Model:
     """Lay out ``scene`` for the kernel; an ``equilibrium`` start is solved for its static shape (unless
     ``solve`` is False: it then holds the solver's first guess, see :mod:`ropesim.analysis.statics`)."""
     lines = line_layouts(scene)
+    nodes = _system_nodes(scene, lines) if scene.is_system else _rope_nodes(scene)
+    x0, v0, mass, held, held_v = nodes.x0, nodes.v0, nodes.mass, nodes.held, nodes.held_v
+    for body in lumped_bodies(scene, lines):
+        mass[body.node] += body.mass
+    held_idx = np.flatnonzero(held).astype(np.int64)
+    v0[:, held_idx] = held_v[:, held_idx]
+
+    layout = Layout(mass, held, node_lengths(lines, len(mass)), lines)
+    motion = motion_of(scene.dimension, held_idx, nodes.drives)
+    model = Model(scene=scene, x0=x0, v0=v0, mass=mass, drag=nodes.drag, held=held, held_idx=held_idx,
+                  held_x0=np.ascontiguousarray(x0[:, held_idx]), held_v=np.ascontiguousarray(held_v[:, held_idx]),
+                  params=model_params(scene, layout), motion=motion,
+                  switches=switches(scene) | ({WITH_MOTION.name} if motion.moving else set()), lines=lines)
+    if solve and isinstance(scene.initial, (S.EquilibriumStart, S.SystemEquilibriumStart)):
+        from .statics import solve_equilibrium
+
+        result = solve_equilibrium(model)
+        if not result.converged:
+            raise EquilibriumError(f"{scene.name}: initial.shape = 'equilibrium': the static solve did not converge "
+                                   f"(largest residual force {result.residual:.3g} N after {result.iterations} "
+                                   f"iterations); start from another shape")
+        model.x0[:] = result.x
+    return model
+
+
+def _rope_nodes(scene: S.Scene) -> Nodes:
+    """A rope's nodes: its initial shape, per-node masses (end nodes in physical units half a segment's) with the
+    overrides, linear drag, pinned and driven nodes."""
     n, dim = scene.rope.nodes, scene.dimension
     x0 = initial_positions(scene)
     v0 = np.empty((dim, n))
@@ -107,36 +149,51 @@ def build(scene: S.Scene, solve: bool = True) -> Model:
             mass[i] = o.mass
         if o.drag is not None:
             drag[i] = o.drag
-    for body in scene.bodies:
-        mass[scene.node(body.node)] += body.mass
 
     held_v = np.zeros((dim, n))
     held = np.zeros(n, dtype=bool)
     if scene.pinned is not None:
         held[[scene.node(i) for i in scene.pinned.nodes]] = True
+    drives = []
     for drive in scene.driven:
         idx = [scene.node(i) for i in drive.nodes]
         held[idx] = True
         held_v[:, idx] = np.asarray(drive.velocity)[:, None]
-    held_idx = np.flatnonzero(held).astype(np.int64)
-    v0[:, held_idx] = held_v[:, held_idx]
+        drives.append((idx, drive))
+    return Nodes(x0, v0, mass, drag, held_v, held, drives)
 
-    layout = Layout(mass, held, node_lengths(lines, n), lines)
-    motion = motion_of(scene, held_idx)
-    model = Model(scene=scene, x0=x0, v0=v0, mass=mass, drag=drag, held=held, held_idx=held_idx,
-                  held_x0=np.ascontiguousarray(x0[:, held_idx]), held_v=np.ascontiguousarray(held_v[:, held_idx]),
-                  params=model_params(scene, layout), motion=motion,
-                  switches=switches(scene) | ({WITH_MOTION.name} if motion.moving else set()), lines=lines)
-    if solve and isinstance(scene.initial, S.EquilibriumStart):
-        from .statics import solve_equilibrium
 
-        result = solve_equilibrium(model)
-        if not result.converged:
-            raise EquilibriumError(f"{scene.name}: initial.shape = 'equilibrium': the static solve did not converge "
-                                   f"(largest residual force {result.residual:.3g} N after {result.iterations} "
-                                   f"iterations); start from another shape")
-        model.x0[:] = result.x
-    return model
+def _system_nodes(scene: S.Scene, lines) -> Nodes:
+    """A system's nodes: each line from its start point to its end point (straight, or sagging when longer than
+    the distance), lumped in physical units (each node half of each segment it touches); the line ends on fixed
+    points pinned, on driven points driven with their point; at rest (driven ends at their velocity)."""
+    dim = scene.dimension
+    n = sum(line.nodes for line in lines)
+    points = {p.id: p for p in scene.points}
+    x0, v0, mass = np.zeros((dim, n)), np.zeros((dim, n)), np.zeros(n)
+    for line, layout in zip(scene.lines, lines):
+        part = slice(layout.first, layout.end)
+        start, end = (np.asarray(point_position(scene, points[key]), dtype=float) for key in (line.start, line.end))
+        x0[:, part] = sagging_line(start, end, layout.nodes, line.length, scene.seabed)
+        mass[part] = line.mass_per_length * layout.segment_length
+        mass[[layout.first, layout.end - 1]] *= 0.5
+    held, held_v, drives = np.zeros(n, dtype=bool), np.zeros((dim, n)), []
+    for point_id, ends in point_ends(scene, lines).items():
+        point = points[point_id]
+        if point.kind in ("fixed", "driven") and ends:
+            held[ends] = True
+        if point.kind == "driven" and ends:
+            held_v[:, ends] = np.asarray(point.velocity)[:, None]
+            drives.append((ends, point))
+    return Nodes(x0, v0, mass, np.zeros(n), held_v, held, drives)
+
+
+def point_position(scene: S.Scene, point: S.Point) -> tuple:
+    """A system point's position at t = 0 [m] (a body's point: its body's reference point plus its offset turned
+    by the body's orientation)."""
+    if point.kind != "body":
+        return point.position
+    raise NotImplementedError("points on rigid bodies come with rigid bodies")
 
 
 class EquilibriumError(ValueError):

@@ -121,3 +121,46 @@ def line_volumes(lines: tuple[LineLayout, ...], node_length: np.ndarray) -> np.n
             part = slice(line.first, line.end)
             volume[part] = math.pi * line.diameter ** 2 / 4.0 * node_length[part]
     return volume
+
+
+@dataclass(frozen=True)
+class Lumped:
+    """A body lumped at one node: its mass joins the node's, its volume the node's displaced volume (buoyancy,
+    added mass rho Ca V in every direction), its CdA the node's drag. A rope's point body (``[[bodies]]`` with
+    ``node``), or a system's free point, lumped at the first line end that sits on it (the point's other line
+    ends move with that node: :func:`junctions`)."""
+
+    node: int
+    mass: float
+    volume: float
+    cd_area: float
+    ca: float
+
+
+def point_ends(scene, lines: tuple[LineLayout, ...] | None = None) -> dict[str, list[int]]:
+    """A system's line end nodes on each point, by point id, in line order (first the start, then the end of
+    each line)."""
+    lines = line_layouts(scene) if lines is None else lines
+    ends: dict[str, list[int]] = {p.id: [] for p in scene.points}
+    for line, layout in zip(scene.lines, lines):
+        ends[line.start].append(layout.first)
+        ends[line.end].append(layout.end - 1)
+    return ends
+
+
+def lumped_bodies(scene, lines: tuple[LineLayout, ...] | None = None) -> tuple[Lumped, ...]:
+    """The bodies lumped at nodes (see :class:`Lumped`): a rope's point bodies, a system's free points."""
+    if scene.rope is not None:
+        return tuple(Lumped(scene.node(b.node), b.mass, b.volume, b.cd_area, b.ca) for b in scene.bodies)
+    ends = point_ends(scene, lines)
+    return tuple(Lumped(ends[p.id][0], p.mass, p.volume, p.cd_area, p.ca) for p in scene.points
+                 if p.kind == "free" and ends[p.id])
+
+
+def junctions(scene, lines: tuple[LineLayout, ...] | None = None) -> list[list[int]]:
+    """A system's free points as groups of line end nodes that move together: the first (which carries the
+    point, :func:`lumped_bodies`), then the others. Empty for a rope and for points with one line."""
+    if scene.rope is not None:
+        return []
+    ends = point_ends(scene, lines)
+    return [ends[p.id] for p in scene.points if p.kind == "free" and len(ends[p.id]) > 1]

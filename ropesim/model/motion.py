@@ -36,21 +36,24 @@ from . import jit
 Motion = namedtuple("Motion", ["moving", "base", "amp", "omega", "phase", "ramp", "path_t", "path_d", "span", "accel"])
 
 
-def motion_of(scene, held_idx: np.ndarray) -> Motion:
-    """The held nodes' prescribed motion (all zero and ``moving`` False for pins and constant drives)."""
-    dim, h = scene.dimension, len(held_idx)
+def motion_of(dim: int, held_idx: np.ndarray, drives) -> Motion:
+    """The held nodes' prescribed motion (all zero and ``moving`` False for pins and constant drives).
+
+    ``drives``: (nodes, drive) pairs, the node indices a drive moves and its motion (velocity, amplitude,
+    period, phase, path_table, ramp_time: a rope's ``[[driven]]`` entry or a system's driven point)."""
+    h = len(held_idx)
     base, amp, omega, phase = (np.zeros((dim, h)) for _ in range(4))
     ramp, span = np.zeros(h), np.zeros((h, 2), dtype=np.int64)
     times, rows = [], []
     where = {int(i): j for j, i in enumerate(held_idx)}
-    for drive in scene.driven:
+    for nodes, drive in drives:
         first = len(times)
         if drive.path_table is not None:
             table = np.asarray(drive.path_table)
             times.extend(table[:, 0])
             rows.extend(table[:, 1:])
-        for node in drive.nodes:
-            j = where[scene.node(node)]
+        for node in nodes:
+            j = where[node]
             base[:, j] = drive.velocity
             ramp[j] = drive.ramp_time
             if drive.amplitude is not None:
@@ -59,7 +62,7 @@ def motion_of(scene, held_idx: np.ndarray) -> Motion:
                 phase[:, j] = np.radians(drive.phase)
             span[j] = (first, len(times))
     path_d = np.asarray(rows, dtype=float).T.copy() if rows else np.zeros((dim, 0))
-    moving = any(d.moving for d in scene.driven)
+    moving = any(drive.moving for _, drive in drives)
     return Motion(moving, base, amp, omega, phase, ramp, np.asarray(times, dtype=float), path_d, span,
                   np.zeros((dim, h)))
 

@@ -54,7 +54,8 @@ from .forces.thrower import THROWER as THROWER_TERM
 from .forces.thrower import WITH_THROWER, add_thrower, add_thrower_jacobian
 from .banded import WITH_WRAP_AROUND
 from .forces.fluid import neighbours
-from .layout import line_layouts, line_table
+from .junctions import WITH_JUNCTIONS, junction_bundle, move_junctions, no_junctions
+from .layout import junctions, line_layouts, line_table
 from .jacobian import pair_damper_blocks, pair_spring_blocks
 from . import jit
 
@@ -68,13 +69,14 @@ WITH_APPLIED = jit.Switch("applied", "a term whose work the ledger books as box_
 WITH_MOTION = jit.Switch("motion", "a held node with a prescribed motion beyond x0 + V t")
 
 ModelParams = namedtuple("ModelParams", [
-    "inv_mass", "node_length", "lines", "neighbours", "spring", "bending", "gravity", "buoyancy", "thrower",
-    "guides", "axial", "fluid_drag", "viscous_drag", "body_drag", "flow", "flow_push", "added_mass", "seabed",
-    "bending_ei", "flow_inertia"])
+    "inv_mass", "node_length", "lines", "neighbours", "junctions", "spring", "bending", "gravity", "buoyancy",
+    "thrower", "guides", "axial", "fluid_drag", "viscous_drag", "body_drag", "flow", "flow_push", "added_mass",
+    "seabed", "bending_ei", "flow_inertia"])
 """What the compiled code knows of the model's forces: 1 / m per node (N,), each node's share of unstretched
 length (N,) [m], the lines' nodes (L, 2) (first, one past the last: :func:`ropesim.model.layout.line_table`),
-the nodes whose chord gives each node's tangent (2, N) (:func:`ropesim.model.forces.fluid.neighbours`), and
-each term's parameters, in TERMS order (see each term's module for its layout)."""
+the nodes whose chord gives each node's tangent (2, N) (:func:`ropesim.model.forces.fluid.neighbours`), a
+system's free points (:class:`ropesim.model.junctions.Junctions`), and each term's parameters, in TERMS order
+(see each term's module for its layout)."""
 
 Layout = namedtuple("Layout", ["mass", "held", "node_length", "lines"])
 """What a term's ``params`` builder gets besides the scene: per-node mass [kg], held (bool) and length [m], and
@@ -88,7 +90,9 @@ def model_params(scene, layout: Layout) -> ModelParams:
     around = np.tile(np.arange(n, dtype=np.int64), (2, 1))   # a node on no line: its own neighbour, no tangent
     for line in layout.lines:
         around[:, line.first:line.end] = neighbours(line.first, line.nodes, line.closed)
-    return ModelParams(1.0 / layout.mass, layout.node_length, line_table(layout.lines), around, *values)
+    groups = junctions(scene, layout.lines)
+    points = junction_bundle(groups, values[TERMS.index(ADDED_MASS_TERM)]) if groups else no_junctions()
+    return ModelParams(1.0 / layout.mass, layout.node_length, line_table(layout.lines), around, points, *values)
 
 
 def declared_terms(scene) -> tuple:
@@ -104,7 +108,9 @@ def switches(scene) -> jit.Switches:
     on = {term.switch.name for term in declared if term.switch is not None}
     if any(line.closed for line in line_layouts(scene)):
         on.add(WITH_WRAP_AROUND.name)
-    if any(term.velocity for term in declared):
+    if junctions(scene):
+        on.add(WITH_JUNCTIONS.name)
+    if any(term.velocity for term in declared) or junctions(scene):   # a junction's kick solves for its point
         on.add(WITH_VELOCITY_TERMS.name)
     if any(term.ledger == "box" for term in declared):
         on.add(WITH_APPLIED.name)
@@ -173,12 +179,16 @@ def accelerations(x, v, acc, p, t):
 
 
 @jit.kernel
-def added_mass(x, v, acc, p):
-    """With added mass on, turn ``acc`` (every force / m, drag included) into M^-1 F; returns the power [W] of
-    the fluid's inertial force (0 without added mass)."""
+def solve_accelerations(x, v, acc, p):
+    """Turn ``acc`` (every force / m, drag included) into the accelerations: M^-1 F at each node with added mass,
+    and a system's free points moved as one (:mod:`ropesim.model.junctions`); returns the power [W] of the
+    fluid's inertial force. Called wherever forces become accelerations, when either is on."""
+    power = 0.0
     if WITH_ADDED_MASS:
-        return apply_added_mass(x, v, acc, p.added_mass, p.inv_mass, p.neighbours)
-    return 0.0
+        power += apply_added_mass(x, v, acc, p.added_mass, p.inv_mass, p.neighbours)
+    if WITH_JUNCTIONS:
+        power += move_junctions(x, v, acc, p.inv_mass, p.junctions, p.neighbours)
+    return power
 
 
 @jit.kernel

@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from . import Term
-from ..layout import line_volumes, per_node
+from ..layout import line_volumes, lumped_bodies, per_node
 from .fluid import node_tangent
 from .. import jit
 
@@ -84,13 +84,13 @@ def _params(scene, layout) -> np.ndarray:
         added[0] = scene.fluid.density * per_node(layout.lines, n, [line.ca_normal for line in layout.lines]) * rope_volume
         added[1] = scene.fluid.density * per_node(layout.lines, n, [line.ca_tangential for line in layout.lines]) \
             * rope_volume
-    for body in scene.bodies:
+    for body in lumped_bodies(scene, layout.lines):
         if body.ca > 0:
-            added[:, scene.node(body.node)] += scene.fluid.density * body.ca * body.volume
+            added[:, body.node] += scene.fluid.density * body.ca * body.volume
     added[:, layout.held] = 0.0
     return added
 
 
 ADDED_MASS_TERM = Term("added_mass", WITH_ADDED_MASS, _params, lambda: np.zeros((2, 0)), ledger="fluid", velocity=True,
-                       active=lambda scene: scene.added_mass is not None or any(b.ca > 0 for b in scene.bodies))
+                       active=lambda scene: scene.added_mass is not None or any(b.ca > 0 for b in lumped_bodies(scene)))
 """Added mass (it needs no force of its own: it changes how every force accelerates a node)."""

@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from . import Term
-from ..layout import line_volumes
+from ..layout import line_volumes, lumped_bodies
 from .. import jit
 
 WITH_BUOYANCY = jit.Switch("buoyancy", "buoyancy")
@@ -28,8 +28,8 @@ def add_buoyancy(acc, up):
 def displaced_volume(scene, layout) -> np.ndarray:
     """Each node's displaced volume [m^3]: its share of its line's and its body's."""
     volume = line_volumes(layout.lines, layout.node_length)
-    for body in scene.bodies:
-        volume[scene.node(body.node)] += body.volume
+    for body in lumped_bodies(scene, layout.lines):
+        volume[body.node] += body.volume
     return volume
 
 

@@ -31,7 +31,7 @@ import math
 import numpy as np
 
 from . import Term
-from ..layout import per_node
+from ..layout import lumped_bodies, per_node
 from .. import jit
 
 WITH_FLUID_DRAG = jit.Switch("fluid_drag", "Morison quadratic drag")
@@ -310,8 +310,8 @@ def _fluid_drag(scene, layout) -> np.ndarray:
 
 def _body_drag(scene, layout) -> np.ndarray:
     out = np.zeros(len(layout.mass))
-    for body in scene.bodies:
-        out[scene.node(body.node)] = 0.5 * scene.fluid.density * body.cd_area if body.cd_area > 0 else 0.0
+    for body in lumped_bodies(scene, layout.lines):
+        out[body.node] = 0.5 * scene.fluid.density * body.cd_area if body.cd_area > 0 else 0.0
     return out
 
 
@@ -349,7 +349,7 @@ VISCOUS_DRAG_TERM = Term(
                                        / model.mass[~model.held], initial=0.0)))
 BODY_DRAG_TERM = Term(
     "bodies", WITH_BODY_DRAG, _body_drag, lambda: np.zeros(0), ledger="fluid", velocity=True,
-    active=lambda scene: any(b.cd_area > 0 for b in scene.bodies),
+    active=lambda scene: any(b.cd_area > 0 for b in lumped_bodies(scene)),
     damping=lambda model: float(np.max(2.0 * model.params.body_drag * speed_scale(model) / model.mass,
                                        initial=0.0)))
 FLOW_TERM = Term("flow", WITH_FLOW, _flow, lambda: (np.zeros(FLOW_PARAMS), np.zeros((0, 4))))
