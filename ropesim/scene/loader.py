@@ -6,7 +6,6 @@ allowed, e.g. ``scenarios/x.toml: rope.mass: must be a number > 0, got -1``.
 
 from __future__ import annotations
 
-import difflib
 import math
 import tomllib
 from dataclasses import fields, replace
@@ -16,15 +15,12 @@ from typing import Any
 from . import schema as S
 from .builtin import resolve
 from .errors import SceneError
+from .motion import complete_motion
+from .values import (MAX_MAGNITUDE, MAX_NAME_BYTES, MAX_SCENE_BYTES, MIN_POSITIVE, choices_text, parse_value, show,
+                     unit_of, unknown_key)
 
 
 MAX_STEPS = 1e12  # a run of more steps would take days; t_end / dt beyond it is a typo, not a plan
-MAX_MAGNITUDE = 1e12  # in SI units: 7 AU, 30 000 years, a 1e12 N/m spring; no rope scene needs more
-MIN_POSITIVE = 1e-12  # the least value of a quantity that must be > 0, so that ratios such as k / m stay finite
-MAX_SCENE_BYTES = 16 * 2 ** 20   # a scene file is a few kB; an inline path table of 100 000 rows about 5 MB
-MAX_TEXT = 1000       # characters of any text value (a description is one line)
-MAX_NAME_BYTES = 200  # a scene's name names its run folder; 255 bytes is the usual file-name limit
-MAX_PATH_ROWS = 100_000  # rows of a driven node's path (a 3-hour path every 0.1 s); scene.toml stores them
 BOM = "\ufeff"        # a UTF-8 byte-order mark, which some Windows editors put first; TOML does not allow it
 
 
@@ -141,7 +137,7 @@ def scene_from_dict(raw: dict, source: str = "<scene>", default_name: str = "sce
     allowed = list(S.TOP_LEVEL_SCALARS) + list(S.TABLES) + list(S.ARRAYS_OF_TABLES)
     for key in raw:
         if key not in allowed:
-            raise SceneError(source, key, _unknown(key, allowed, "a top-level key or table"))
+            raise SceneError(source, key, unknown_key(key, allowed, "a top-level key or table"))
     for key in S.REQUIRED_TABLES:
         if key not in raw:
             raise SceneError(source, key, f"missing: every scene needs a [{key}] table")
@@ -149,7 +145,7 @@ def scene_from_dict(raw: dict, source: str = "<scene>", default_name: str = "sce
     top = {}
     for key, sp in S.TOP_LEVEL_SCALARS.items():
         if key in raw:
-            top[key] = _value(raw[key], sp, key, source, dim=0)
+            top[key] = parse_value(raw[key], sp, key, source, dim=0)
     dim = top.get("dimension", 2)
     ctx = _Ctx(source, dim)
 
@@ -164,7 +160,7 @@ def scene_from_dict(raw: dict, source: str = "<scene>", default_name: str = "sce
             if isinstance(items, dict):
                 items = [items]
             if not isinstance(items, list):
-                raise SceneError(source, key, f"must be an array of tables ([[{key}]]), got {_show(items)}")
+                raise SceneError(source, key, f"must be an array of tables ([[{key}]]), got {show(items)}")
             parts[key] = tuple(ctx.table(items, i, cls, prefix=key) for i in range(len(items)))
     parts["initial"] = ctx.initial(raw)
 
@@ -185,7 +181,7 @@ class _Ctx:
         path = f"{prefix}.{key}" if prefix else str(key)
         raw = container[key]
         if not isinstance(raw, dict):
-            raise SceneError(self.source, path, f"must be a table, got {_show(raw)}")
+            raise SceneError(self.source, path, f"must be a table, got {show(raw)}")
         return self.build(raw, cls, path)
 
     def build(self, raw: dict, cls, path: str, skip: tuple = (), what: str = ""):
@@ -193,23 +189,23 @@ class _Ctx:
         for key in raw:
             if key not in specs and key not in skip:
                 raise SceneError(self.source, f"{path}.{key}",
-                                 _unknown(key, list(skip) + list(specs), what or f"a key of [{path}]"))
+                                 unknown_key(key, list(skip) + list(specs), what or f"a key of [{path}]"))
         values = {}
         for name, sp in specs.items():
             if name in raw:
-                values[name] = _value(raw[name], sp, f"{path}.{name}", self.source, self.dim)
+                values[name] = parse_value(raw[name], sp, f"{path}.{name}", self.source, self.dim)
             elif sp.required:
-                raise SceneError(self.source, f"{path}.{name}", f"missing: {sp.doc}{_unit(sp)}")
+                raise SceneError(self.source, f"{path}.{name}", f"missing: {sp.doc}{unit_of(sp)}")
         return cls(**values)
 
     def initial(self, raw: dict):
         init = raw["initial"]
         if not isinstance(init, dict):
-            raise SceneError(self.source, "initial", f"must be a table, got {_show(init)}")
+            raise SceneError(self.source, "initial", f"must be a table, got {show(init)}")
         shape_spec = S.Spec("str", "initial shape", choices=tuple(S.INITIAL_SHAPES))
         if "shape" not in init:
-            raise SceneError(self.source, "initial.shape", f"missing: one of {_choices(shape_spec.choices)}")
-        shape = _value(init["shape"], shape_spec, "initial.shape", self.source, self.dim)
+            raise SceneError(self.source, "initial.shape", f"missing: one of {choices_text(shape_spec.choices)}")
+        shape = parse_value(init["shape"], shape_spec, "initial.shape", self.source, self.dim)
         start = self.build(init, S.INITIAL_SHAPES[shape], "initial", skip=("shape",),
                            what=f"a key of [initial] with shape = '{shape}'")
         zeros = (0.0,) * self.dim
@@ -243,91 +239,10 @@ def _check_scene(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
 
 def _resolve_driven(scene: S.Scene, base_dir: Path, fail) -> S.Scene:
     """Each drive's defaults (no velocity: still; no phase: 0), its sinusoid complete, its path read."""
-    zeros = (0.0,) * scene.dimension
-    drives = []
-    for g, drive in enumerate(scene.driven):
-        key = f"driven.{g}"
-        drive = replace(drive, velocity=drive.velocity if drive.velocity is not None else zeros)
-        if drive.amplitude is not None:
-            if drive.period is None:
-                fail(f"{key}.period", "missing: a sinusoid needs its period per axis (with amplitude)")
-            if any(a != 0.0 and not T > 0.0 for a, T in zip(drive.amplitude, drive.period)):
-                fail(f"{key}.period", f"must be > 0 on every axis that moves, got {list(drive.period)}")
-            drive = replace(drive, phase=drive.phase if drive.phase is not None else zeros)
-        elif drive.period is not None or drive.phase is not None:
-            fail(f"{key}.{'period' if drive.period is not None else 'phase'}", "is used only with amplitude")
-        if drive.path is not None and drive.path_table is not None:
-            fail(f"{key}.path_table", "give the path either as a CSV file (path) or inline (path_table), not both")
-        if drive.path is not None:
-            drive = replace(drive, path=None, path_table=_read_path(drive.path, base_dir, scene, f"{key}.path", fail))
-        if drive.path_table is not None:
-            _check_path(drive.path_table, scene, f"{key}.path_table", "", fail)
-        drives.append(drive)
-    return replace(scene, driven=tuple(drives))
-
-
-def _read_path(name: str, base_dir: Path, scene: S.Scene, key: str, fail) -> tuple:
-    """The CSV path's rows (t, dx, dy[, dz]), checked like an inline ``path_table``; the file name is taken
-    relative to the scene file's folder."""
-    import csv
-
-    path = Path(name)
-    path = path if path.is_absolute() else (base_dir / path)
-    try:
-        size = path.stat().st_size
-        if size > MAX_SCENE_BYTES and path.is_file():
-            fail(key, f"{path} is {size / 1e6:.3g} MB; a path is at most {MAX_PATH_ROWS:,} rows "
-                      f"({MAX_SCENE_BYTES / 1e6:.3g} MB): resample it")
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        fail(key, f"cannot read {path} ({exc.__class__.__name__})")
-    columns = scene.dimension + 1
-    rows = []
-    for number, row in enumerate(csv.reader(text.splitlines()), start=1):
-        if not row or row[0].lstrip().startswith("#"):
-            continue
-        if len(rows) == MAX_PATH_ROWS:
-            fail(key, f"{path}: more than {MAX_PATH_ROWS:,} rows; a path is at most that many (the run folder's "
-                      f"scene.toml keeps them): resample it")
-        try:
-            values = [float(v) for v in row]
-        except ValueError:
-            if not rows:
-                continue   # a header line
-            fail(key, f"{path}, line {number}: not numbers: {_show(row)}")
-        if len(values) != columns or not all(math.isfinite(v) for v in values):
-            fail(key, f"{path}, line {number}: needs {columns} finite numbers (t, dx, dy{', dz' if columns == 4 else ''}), "
-                      f"got {_show(row)}")
-        if any(abs(v) > MAX_MAGNITUDE for v in values):
-            fail(key, f"{path}, line {number}: numbers must be at most {MAX_MAGNITUDE:g} in magnitude (s, m), as "
-                      f"in a scene file; got {_show(row)}")
-        rows.append(tuple(values))
-    _check_path(rows, scene, key, f"{path}: ", fail)
-    return tuple(rows)
-
-
-def _check_path(rows, scene: S.Scene, key: str, where: str, fail) -> None:
-    """At least two rows, times increasing from at most 0 to at least t_end, no displacement at t = 0."""
-    if len(rows) < 2:
-        fail(key, f"{where}needs at least two rows of t, dx, dy{', dz' if scene.dimension == 3 else ''}")
-    times = [r[0] for r in rows]
-    for a, b in zip(times, times[1:]):
-        if not b > a:
-            fail(key, f"{where}times must increase, but {b:g} s follows {a:g} s")
-    if times[0] > 0.0 or times[-1] < scene.integrator.t_end:
-        fail(key, f"{where}covers t = {times[0]:g} to {times[-1]:g} s, but the run goes from 0 to "
-                  f"{scene.integrator.t_end:g} s")
-    start = [float(v) for v in _interpolate(rows, 0.0)]
-    if any(abs(v) > 1e-12 for v in start):
-        fail(key, f"{where}the displacement at t = 0 is {start}, not zero (the path moves the node from where "
-                  f"the scene starts it)")
-
-
-def _interpolate(rows, t: float) -> tuple:
-    import numpy as np
-
-    table = np.asarray(rows)
-    return tuple(np.interp(t, table[:, 0], table[:, c]) for c in range(1, table.shape[1]))
+    labels = ("dx", "dy", "dz")[: scene.dimension]
+    drives = tuple(complete_motion(drive, f"driven.{g}", labels, scene.dimension, base_dir, scene.integrator.t_end,
+                                   fail) for g, drive in enumerate(scene.driven))
+    return replace(scene, driven=drives)
 
 
 def _check_seabed(scene: S.Scene, fail) -> None:
@@ -365,7 +280,7 @@ def _resolve_rope(rope: S.Rope, source: str) -> S.Rope:
         for key in PER_NODE_KEYS:
             if getattr(rope, key) is None:
                 spec = {f.name: f.metadata["spec"] for f in fields(S.Rope)}[key]
-                fail(key, f"missing: {spec.doc}{_unit(spec)}; or give the rope in physical units (length, "
+                fail(key, f"missing: {spec.doc}{unit_of(spec)}; or give the rope in physical units (length, "
                           f"segments, mass_per_length, EA)")
         return replace(rope, compression=True if rope.compression is None else rope.compression)
     for key in ("length", "EA"):
@@ -407,7 +322,7 @@ def _resolve_rope(rope: S.Rope, source: str) -> S.Rope:
     for key, (physical, how) in origin.items():   # the derived per-node values obey the per-node keys' limits
         value, spec = derived[key], {f.name: f.metadata["spec"] for f in fields(S.Rope)}[key]
         if not MIN_POSITIVE <= value <= MAX_MAGNITUDE:
-            fail(physical, f"gives {key} = {how} = {value:g}{_unit(spec)}, outside {MIN_POSITIVE:g} to "
+            fail(physical, f"gives {key} = {how} = {value:g}{unit_of(spec)}, outside {MIN_POSITIVE:g} to "
                            f"{MAX_MAGNITUDE:g} (its products and ratios would overflow)")
     return replace(rope, segments=segments, mass_per_length=per_metre,
                    compression=False if rope.compression is None else rope.compression, **derived)
@@ -467,7 +382,7 @@ def _check_flow(flow: S.Flow, dim: int, fail) -> None:
             fail("flow.velocities", f"has {len(flow.velocities)} rows but flow.heights has {len(flow.heights)}; "
                                     f"give one velocity per height")
         if any(b <= a for a, b in zip(flow.heights, flow.heights[1:])):
-            fail("flow.heights", f"must increase strictly, got {_show(list(flow.heights))}")
+            fail("flow.heights", f"must increase strictly, got {show(list(flow.heights))}")
 
 
 def _check_flow_covers_the_rope(scene: S.Scene, fail) -> None:
@@ -488,7 +403,7 @@ def _check_name_and_length(scene: S.Scene, fail) -> None:
     name = scene.name
     if not name or name in (".", "..") or "/" in name or "\\" in name or not name.isprintable():
         fail("name", f"must be a plain folder name (runs go to runs/<name>/): printable, without / or \\, "
-                     f"not '.' or '..'; got {_show(name)}")
+                     f"not '.' or '..'; got {show(name)}")
     if len(name.encode("utf-8")) > MAX_NAME_BYTES:
         fail("name", f"must be at most {MAX_NAME_BYTES} bytes in UTF-8 (it names the run folder), got "
                      f"{len(name.encode('utf-8'))}")
@@ -654,140 +569,3 @@ def _resolve_omegas(scene: S.Scene, fail) -> S.Scene:
             guide = replace(guide, omega0=scene.thrower.omega0)
         guides.append(guide)
     return replace(scene, guides=tuple(guides))
-
-
-# ------------------------------------------------------------------------------ single values
-
-
-def _value(value: Any, sp: S.Spec, key: str, source: str, dim: int):
-    def bad(what):
-        raise SceneError(source, key, f"{what}{_unit(sp)}, got {_show(value)}")
-
-    if sp.kind == "bool":
-        if not isinstance(value, bool):
-            bad("must be true or false")
-        return value
-    if sp.kind == "str":
-        if not isinstance(value, str):
-            bad(f"must be one of {_choices(sp.choices)}" if sp.choices else "must be a string")
-        if len(value) > MAX_TEXT:
-            raise SceneError(source, key, f"must be at most {MAX_TEXT} characters, got {len(value):,}")
-        if sp.choices and value not in sp.choices:
-            near = difflib.get_close_matches(value, sp.choices, n=1)
-            hint = f" (did you mean '{near[0]}'?)" if near else ""
-            raise SceneError(source, key, f"must be one of {_choices(sp.choices)}, got {_show(value)}{hint}")
-        return value
-    if sp.kind == "int":
-        if isinstance(value, bool) or not isinstance(value, int):
-            bad(f"must be one of {_choices(sp.choices)}" if sp.choices else f"must be {_range(sp, 'an integer')}")
-        if sp.choices and value not in sp.choices:
-            bad(f"must be one of {_choices(sp.choices)}")
-        _bounds(value, sp, key, source, "an integer")
-        return value
-    if sp.kind == "float":
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            bad(f"must be {_range(sp, 'a number')}")
-        if not _finite(value):
-            bad("must be a finite number")
-        value = float(value)
-        _bounds(value, sp, key, source, "a number")
-        _magnitude(value, sp, key, source)
-        return value
-    if sp.kind == "vector":
-        return _vector(value, dim, key, source, sp)
-    if sp.kind == "int_list":
-        if isinstance(value, int) and not isinstance(value, bool):
-            value = [value]
-        if not isinstance(value, list) or not value or not all(
-                isinstance(v, int) and not isinstance(v, bool) for v in value):
-            bad("must be a non-empty list of node indices (integers)")
-        return tuple(value)
-    if sp.kind == "float_list":
-        if not isinstance(value, list) or not value or not all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) and _finite(v) for v in value):
-            bad("must be a non-empty list of finite numbers")
-        for v in value:
-            _magnitude(float(v), sp, key, source, shown=value)
-        return tuple(float(v) for v in value)
-    if sp.kind == "points":
-        if not isinstance(value, list) or not value:
-            bad(f"must be a list of points, each a list of {dim} numbers")
-        return tuple(_vector(p, dim, f"{key}[{i}]", source, sp) for i, p in enumerate(value))
-    if sp.kind == "rows":
-        ok = isinstance(value, list) and value and all(
-            isinstance(row, list) and len(row) == dim + 1 and all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) and _finite(v) for v in row) for row in value)
-        if not ok:
-            bad(f"must be a list of rows, each {dim + 1} finite numbers (t, then one per axis)")
-        if len(value) > MAX_PATH_ROWS:
-            raise SceneError(source, key, f"must be at most {MAX_PATH_ROWS:,} rows, got {len(value):,}")
-        for row in value:
-            for v in row:
-                _magnitude(float(v), sp, key, source, shown=row)
-        return tuple(tuple(float(v) for v in row) for row in value)
-    raise AssertionError(sp.kind)
-
-
-def _vector(value, dim, key, source, sp):
-    ok = isinstance(value, list) and len(value) == dim and all(
-        isinstance(v, (int, float)) and not isinstance(v, bool) and _finite(v) for v in value)
-    if not ok:
-        raise SceneError(source, key, f"must be a list of {dim} finite numbers (dimension = {dim}){_unit(sp)}, "
-                                      f"got {_show(value)}")
-    vector = tuple(float(v) for v in value)
-    for v in vector:
-        _magnitude(v, sp, key, source, shown=value)
-    return vector
-
-
-def _finite(v) -> bool:
-    try:
-        return math.isfinite(v)
-    except OverflowError:  # an integer beyond the float range
-        return False
-
-
-def _bounds(value, sp: S.Spec, key, source, what):
-    low_ok = sp.low is None or (value > sp.low if sp.open_low else value >= sp.low)
-    high_ok = sp.high is None or value <= sp.high
-    if not (low_ok and high_ok):
-        raise SceneError(source, key, f"must be {_range(sp, what)}{_unit(sp)}, got {_show(value)}")
-
-
-def _magnitude(value: float, sp: S.Spec, key, source, shown: Any = None):
-    """Refuse numbers whose products would overflow: |value| <= MAX_MAGNITUDE, and >= MIN_POSITIVE when > 0 is
-    required (the products and ratios of a few such numbers stay far inside the float range)."""
-    if abs(value) > MAX_MAGNITUDE:
-        raise SceneError(source, key, f"must be at most {MAX_MAGNITUDE:g} in magnitude{_unit(sp)} (larger numbers "
-                                      f"overflow in products), got {_show(value if shown is None else shown)}")
-    if sp.open_low and sp.low == 0 and value < MIN_POSITIVE:
-        raise SceneError(source, key, f"must be at least {MIN_POSITIVE:g}{_unit(sp)} (smaller ones make ratios "
-                                      f"such as k / m overflow), got {_show(value if shown is None else shown)}")
-
-
-def _range(sp: S.Spec, what: str) -> str:
-    parts = []
-    if sp.low is not None:
-        parts.append(f"{'>' if sp.open_low else '>='} {sp.low:g}")
-    if sp.high is not None:
-        parts.append(f"<= {sp.high:g}")
-    return f"{what} {' and '.join(parts)}" if parts else what
-
-
-def _unit(sp: S.Spec) -> str:
-    return f" [{sp.unit}]" if sp.unit else ""
-
-
-def _choices(choices) -> str:
-    return ", ".join(repr(c) if isinstance(c, str) else str(c) for c in choices)
-
-
-def _unknown(key: str, allowed: list[str], what: str) -> str:
-    near = difflib.get_close_matches(str(key), allowed, n=1, cutoff=0.6)
-    hint = f"did you mean '{near[0]}'? " if near else ""
-    return f"unknown key, not {what}; {hint}allowed: {', '.join(allowed)}"
-
-
-def _show(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
