@@ -64,7 +64,8 @@ def parse_value(value: Any, sp: S.Spec, key: str, source: str, dim: int):
         return value
     if sp.kind == "int":
         if isinstance(value, bool) or not isinstance(value, int):
-            bad(f"must be one of {choices_text(sp.choices)}" if sp.choices else f"must be {range_text(sp, 'an integer')}")
+            bad(f"must be one of {choices_text(sp.choices)}" if sp.choices else
+                f"must be {range_text(sp, 'an integer')}")
         if sp.choices and value not in sp.choices:
             bad(f"must be one of {choices_text(sp.choices)}")
         check_bounds(value, sp, key, source, "an integer")
