@@ -6,7 +6,6 @@ allowed, e.g. ``scenarios/x.toml: rope.mass: must be a number > 0, got -1``.
 
 from __future__ import annotations
 
-import difflib
 import math
 import tomllib
 from dataclasses import fields, replace
@@ -16,15 +15,15 @@ from typing import Any
 from . import schema as S
 from .builtin import resolve
 from .errors import SceneError
+from .material import agree, mass_per_length, per_node
+from .motion import complete_motion
+from .system import (POINT_BODY_IN_A_SYSTEM, RIGID_BODY_IN_A_ROPE, ROPE_ONLY_INSTEAD, SYSTEM_ONLY_INSTEAD,
+                     resolve_system)
+from .values import (MAX_MAGNITUDE, MAX_SCENE_BYTES, MIN_POSITIVE, check_name, choices_text, parse_value, show,
+                     unit_of, unknown_key)
 
 
 MAX_STEPS = 1e12  # a run of more steps would take days; t_end / dt beyond it is a typo, not a plan
-MAX_MAGNITUDE = 1e12  # in SI units: 7 AU, 30 000 years, a 1e12 N/m spring; no rope scene needs more
-MIN_POSITIVE = 1e-12  # the least value of a quantity that must be > 0, so that ratios such as k / m stay finite
-MAX_SCENE_BYTES = 16 * 2 ** 20   # a scene file is a few kB; an inline path table of 100 000 rows about 5 MB
-MAX_TEXT = 1000       # characters of any text value (a description is one line)
-MAX_NAME_BYTES = 200  # a scene's name names its run folder; 255 bytes is the usual file-name limit
-MAX_PATH_ROWS = 100_000  # rows of a driven node's path (a 3-hour path every 0.1 s); scene.toml stores them
 BOM = "\ufeff"        # a UTF-8 byte-order mark, which some Windows editors put first; TOML does not allow it
 
 
@@ -137,24 +136,30 @@ def _list_item(items: list, part: str, here: str, source: str, item: str):
 
 def scene_from_dict(raw: dict, source: str = "<scene>", default_name: str = "scene",
                     base_dir: str | Path | None = None) -> S.Scene:
-    """Validate a raw TOML dict into a :class:`Scene`; raises :class:`SceneError`."""
-    allowed = list(S.TOP_LEVEL_SCALARS) + list(S.TABLES) + list(S.ARRAYS_OF_TABLES)
+    """Validate a raw TOML dict into a :class:`Scene`; raises :class:`SceneError`. A scene with ``[[lines]]`` is a
+    system (see :mod:`ropesim.scene.system`); any other is one rope."""
+    allowed = list(S.TOP_LEVEL_SCALARS) + list(S.TABLES) + list(S.ARRAYS_OF_TABLES) + list(S.NAMED_TABLES)
     for key in raw:
         if key not in allowed:
-            raise SceneError(source, key, _unknown(key, allowed, "a top-level key or table"))
-    for key in S.REQUIRED_TABLES:
+            raise SceneError(source, key, unknown_key(key, allowed, "a top-level key or table"))
+    is_system = "lines" in raw
+    refused = ROPE_ONLY_INSTEAD if is_system else SYSTEM_ONLY_INSTEAD
+    for key in raw:
+        if key in refused:
+            raise SceneError(source, key, refused[key])
+    for key in S.SYSTEM_REQUIRED_TABLES if is_system else S.REQUIRED_TABLES:
         if key not in raw:
-            raise SceneError(source, key, f"missing: every scene needs a [{key}] table")
+            raise SceneError(source, key, f"missing: a system's lines end on [[{key}]]" if key == "points" else
+                             f"missing: every scene needs a [{key}] table")
 
     top = {}
     for key, sp in S.TOP_LEVEL_SCALARS.items():
         if key in raw:
-            top[key] = _value(raw[key], sp, key, source, dim=0)
+            top[key] = parse_value(raw[key], sp, key, source, dim=0)
     dim = top.get("dimension", 2)
     ctx = _Ctx(source, dim)
 
-    rope = _resolve_rope(ctx.table(raw, "rope", S.Rope), source)
-    parts: dict[str, Any] = {"rope": rope}
+    parts: dict[str, Any] = {"rope": None if is_system else _resolve_rope(ctx.table(raw, "rope", S.Rope), source)}
     for key, cls in S.TABLES.items():
         if key not in ("rope", "initial") and key in raw:
             parts[key] = ctx.table(raw, key, cls)
@@ -164,9 +169,20 @@ def scene_from_dict(raw: dict, source: str = "<scene>", default_name: str = "sce
             if isinstance(items, dict):
                 items = [items]
             if not isinstance(items, list):
-                raise SceneError(source, key, f"must be an array of tables ([[{key}]]), got {_show(items)}")
-            parts[key] = tuple(ctx.table(items, i, cls, prefix=key) for i in range(len(items)))
-    parts["initial"] = ctx.initial(raw)
+                raise SceneError(source, key, f"must be an array of tables ([[{key}]]), got {show(items)}")
+            if is_system and key in S.SYSTEM_VARIANTS:
+                cls = S.SYSTEM_VARIANTS[key]
+            parts[key] = tuple(ctx.entry(items, i, cls, key, is_system) for i in range(len(items)))
+    for key, cls in S.NAMED_TABLES.items():
+        if key in raw:
+            parts[key] = ctx.named(raw, key, cls)
+    if is_system:
+        if not parts["lines"]:
+            raise SceneError(source, "lines", "has no entries; a system needs at least one [[lines]] entry")
+        parts["rigid_bodies"] = parts.pop("bodies", ())
+        parts["initial"] = ctx.system_initial(raw)
+    else:
+        parts["initial"] = ctx.initial(raw)
 
     scene = S.Scene(
         name=top.get("name", default_name),
@@ -174,7 +190,8 @@ def scene_from_dict(raw: dict, source: str = "<scene>", default_name: str = "sce
         dimension=dim,
         **parts,
     )
-    return _check_scene(scene, source, Path(base_dir) if base_dir is not None else Path.cwd())
+    base = Path(base_dir) if base_dir is not None else Path.cwd()
+    return _check_system(scene, source, base) if is_system else _check_scene(scene, source, base)
 
 
 class _Ctx:
@@ -185,31 +202,86 @@ class _Ctx:
         path = f"{prefix}.{key}" if prefix else str(key)
         raw = container[key]
         if not isinstance(raw, dict):
-            raise SceneError(self.source, path, f"must be a table, got {_show(raw)}")
+            raise SceneError(self.source, path, f"must be a table, got {show(raw)}")
         return self.build(raw, cls, path)
+
+    def entry(self, items: list, i: int, cls, key: str, is_system: bool):
+        """Entry ``i`` of the array of tables ``key``: a rope's point body is refused in a system and a rigid body
+        (an entry with an id) in a rope scene, each in a line saying what to use instead."""
+        item = items[i]
+        if key == "bodies" and isinstance(item, dict):
+            if is_system and "node" in item and "id" not in item:
+                raise SceneError(self.source, f"bodies.{i}.node", POINT_BODY_IN_A_SYSTEM)
+            if not is_system and "id" in item:
+                raise SceneError(self.source, f"bodies.{i}.id", RIGID_BODY_IN_A_ROPE)
+        if key == "points" and isinstance(item, dict) and "body" in item:
+            return self.body_point(items, i)
+        return self.table(items, i, cls, prefix=key)
+
+    def body_point(self, items: list, i: int):
+        """A point on a rigid body: its position is in the body's frame, given in the scene's dimensions."""
+        try:
+            return self.table(items, i, S.Point, prefix="points")
+        except SceneError as exc:
+            if exc.key != f"points.{i}.position":
+                raise
+            raise SceneError(self.source, exc.key, f"{exc.message}; a point on body {show(items[i]['body'])} is "
+                                                   f"placed in the body's frame, in the scene's {self.dim} "
+                                                   f"dimensions") from None
+
+    def named(self, raw: dict, key: str, cls) -> tuple:
+        """A table of named tables (``[line_types.chain]``, ...): (name, entry) pairs in file order."""
+        table = raw[key]
+        if not isinstance(table, dict):
+            raise SceneError(self.source, key, f"must be a table of named tables ([{key}.NAME]), got {show(table)}")
+        out = []
+        for name in table:
+            check_name(name, f"{key}.{name}", self.fail, "a plain name (lines name it as their type)")
+            if "." in name:
+                self.fail(f"{key}.{name}", f"must not contain '.' (--set addresses it as {key}.NAME.KEY)")
+            out.append((name, self.table(table, name, cls, prefix=key)))
+        return tuple(out)
+
+    def fail(self, key, message):
+        raise SceneError(self.source, key, message)
+
+    def system_initial(self, raw: dict):
+        """A system's start: ``lines`` (the default, also without an [initial] table) or ``equilibrium``."""
+        init = raw.get("initial", {})
+        if not isinstance(init, dict):
+            raise SceneError(self.source, "initial", f"must be a table, got {show(init)}")
+        shape_spec = S.Spec("str", "initial shape", choices=tuple(S.SYSTEM_INITIAL_SHAPES))
+        shape = init.get("shape", "lines")
+        if shape in S.INITIAL_SHAPES and shape not in S.SYSTEM_INITIAL_SHAPES:
+            self.fail("initial.shape", f"'{shape}' starts one rope; a system starts as "
+                                       f"{choices_text(S.SYSTEM_INITIAL_SHAPES)} (its points and bodies where the "
+                                       f"scene puts them)")
+        shape = parse_value(shape, shape_spec, "initial.shape", self.source, self.dim)
+        return self.build(init, S.SYSTEM_INITIAL_SHAPES[shape], "initial", skip=("shape",),
+                          what=f"a key of a system's [initial] with shape = '{shape}'")
 
     def build(self, raw: dict, cls, path: str, skip: tuple = (), what: str = ""):
         specs = {f.name: f.metadata["spec"] for f in fields(cls) if "spec" in f.metadata}
         for key in raw:
             if key not in specs and key not in skip:
                 raise SceneError(self.source, f"{path}.{key}",
-                                 _unknown(key, list(skip) + list(specs), what or f"a key of [{path}]"))
+                                 unknown_key(key, list(skip) + list(specs), what or f"a key of [{path}]"))
         values = {}
         for name, sp in specs.items():
             if name in raw:
-                values[name] = _value(raw[name], sp, f"{path}.{name}", self.source, self.dim)
+                values[name] = parse_value(raw[name], sp, f"{path}.{name}", self.source, self.dim)
             elif sp.required:
-                raise SceneError(self.source, f"{path}.{name}", f"missing: {sp.doc}{_unit(sp)}")
+                raise SceneError(self.source, f"{path}.{name}", f"missing: {sp.doc}{unit_of(sp)}")
         return cls(**values)
 
     def initial(self, raw: dict):
         init = raw["initial"]
         if not isinstance(init, dict):
-            raise SceneError(self.source, "initial", f"must be a table, got {_show(init)}")
+            raise SceneError(self.source, "initial", f"must be a table, got {show(init)}")
         shape_spec = S.Spec("str", "initial shape", choices=tuple(S.INITIAL_SHAPES))
         if "shape" not in init:
-            raise SceneError(self.source, "initial.shape", f"missing: one of {_choices(shape_spec.choices)}")
-        shape = _value(init["shape"], shape_spec, "initial.shape", self.source, self.dim)
+            raise SceneError(self.source, "initial.shape", f"missing: one of {choices_text(shape_spec.choices)}")
+        shape = parse_value(init["shape"], shape_spec, "initial.shape", self.source, self.dim)
         start = self.build(init, S.INITIAL_SHAPES[shape], "initial", skip=("shape",),
                            what=f"a key of [initial] with shape = '{shape}'")
         zeros = (0.0,) * self.dim
@@ -224,6 +296,19 @@ class _Ctx:
         return start
 
 
+def _check_system(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
+    """A system's checks that involve more than one key; returns it with every default filled in."""
+    def fail(key, message):
+        raise SceneError(source, key, message)
+
+    _check_name_and_length(scene, fail)
+    scene = resolve_system(scene, base_dir, fail)
+    _check_fluid(scene, fail)
+    _check_flow_covers_the_start(scene, fail)
+    _check_seabed(scene, fail)
+    return scene
+
+
 def _check_scene(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
     """Checks that involve more than one key; returns the scene with the defaults that depend on others filled."""
     def fail(key, message):
@@ -236,123 +321,52 @@ def _check_scene(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
     scene = _resolve_driven(scene, base_dir, fail)
     scene = _resolve_initial(_read_start(scene, base_dir, fail), fail)
     scene = _resolve_omegas(scene, fail)
-    _check_flow_covers_the_rope(scene, fail)
+    _check_flow_covers_the_start(scene, fail)
     _check_seabed(scene, fail)
     return scene
 
 
 def _resolve_driven(scene: S.Scene, base_dir: Path, fail) -> S.Scene:
     """Each drive's defaults (no velocity: still; no phase: 0), its sinusoid complete, its path read."""
-    zeros = (0.0,) * scene.dimension
-    drives = []
-    for g, drive in enumerate(scene.driven):
-        key = f"driven.{g}"
-        drive = replace(drive, velocity=drive.velocity if drive.velocity is not None else zeros)
-        if drive.amplitude is not None:
-            if drive.period is None:
-                fail(f"{key}.period", "missing: a sinusoid needs its period per axis (with amplitude)")
-            if any(a != 0.0 and not T > 0.0 for a, T in zip(drive.amplitude, drive.period)):
-                fail(f"{key}.period", f"must be > 0 on every axis that moves, got {list(drive.period)}")
-            drive = replace(drive, phase=drive.phase if drive.phase is not None else zeros)
-        elif drive.period is not None or drive.phase is not None:
-            fail(f"{key}.{'period' if drive.period is not None else 'phase'}", "is used only with amplitude")
-        if drive.path is not None and drive.path_table is not None:
-            fail(f"{key}.path_table", "give the path either as a CSV file (path) or inline (path_table), not both")
-        if drive.path is not None:
-            drive = replace(drive, path=None, path_table=_read_path(drive.path, base_dir, scene, f"{key}.path", fail))
-        if drive.path_table is not None:
-            _check_path(drive.path_table, scene, f"{key}.path_table", "", fail)
-        drives.append(drive)
-    return replace(scene, driven=tuple(drives))
-
-
-def _read_path(name: str, base_dir: Path, scene: S.Scene, key: str, fail) -> tuple:
-    """The CSV path's rows (t, dx, dy[, dz]), checked like an inline ``path_table``; the file name is taken
-    relative to the scene file's folder."""
-    import csv
-
-    path = Path(name)
-    path = path if path.is_absolute() else (base_dir / path)
-    try:
-        size = path.stat().st_size
-        if size > MAX_SCENE_BYTES and path.is_file():
-            fail(key, f"{path} is {size / 1e6:.3g} MB; a path is at most {MAX_PATH_ROWS:,} rows "
-                      f"({MAX_SCENE_BYTES / 1e6:.3g} MB): resample it")
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        fail(key, f"cannot read {path} ({exc.__class__.__name__})")
-    columns = scene.dimension + 1
-    rows = []
-    for number, row in enumerate(csv.reader(text.splitlines()), start=1):
-        if not row or row[0].lstrip().startswith("#"):
-            continue
-        if len(rows) == MAX_PATH_ROWS:
-            fail(key, f"{path}: more than {MAX_PATH_ROWS:,} rows; a path is at most that many (the run folder's "
-                      f"scene.toml keeps them): resample it")
-        try:
-            values = [float(v) for v in row]
-        except ValueError:
-            if not rows:
-                continue   # a header line
-            fail(key, f"{path}, line {number}: not numbers: {_show(row)}")
-        if len(values) != columns or not all(math.isfinite(v) for v in values):
-            fail(key, f"{path}, line {number}: needs {columns} finite numbers (t, dx, dy{', dz' if columns == 4 else ''}), "
-                      f"got {_show(row)}")
-        if any(abs(v) > MAX_MAGNITUDE for v in values):
-            fail(key, f"{path}, line {number}: numbers must be at most {MAX_MAGNITUDE:g} in magnitude (s, m), as "
-                      f"in a scene file; got {_show(row)}")
-        rows.append(tuple(values))
-    _check_path(rows, scene, key, f"{path}: ", fail)
-    return tuple(rows)
-
-
-def _check_path(rows, scene: S.Scene, key: str, where: str, fail) -> None:
-    """At least two rows, times increasing from at most 0 to at least t_end, no displacement at t = 0."""
-    if len(rows) < 2:
-        fail(key, f"{where}needs at least two rows of t, dx, dy{', dz' if scene.dimension == 3 else ''}")
-    times = [r[0] for r in rows]
-    for a, b in zip(times, times[1:]):
-        if not b > a:
-            fail(key, f"{where}times must increase, but {b:g} s follows {a:g} s")
-    if times[0] > 0.0 or times[-1] < scene.integrator.t_end:
-        fail(key, f"{where}covers t = {times[0]:g} to {times[-1]:g} s, but the run goes from 0 to "
-                  f"{scene.integrator.t_end:g} s")
-    start = [float(v) for v in _interpolate(rows, 0.0)]
-    if any(abs(v) > 1e-12 for v in start):
-        fail(key, f"{where}the displacement at t = 0 is {start}, not zero (the path moves the node from where "
-                  f"the scene starts it)")
-
-
-def _interpolate(rows, t: float) -> tuple:
-    import numpy as np
-
-    table = np.asarray(rows)
-    return tuple(np.interp(t, table[:, 0], table[:, c]) for c in range(1, table.shape[1]))
+    labels = ("dx", "dy", "dz")[: scene.dimension]
+    drives = tuple(complete_motion(drive, f"driven.{g}", labels, scene.dimension, base_dir, scene.integrator.t_end,
+                                   fail) for g, drive in enumerate(scene.driven))
+    return replace(scene, driven=drives)
 
 
 def _check_seabed(scene: S.Scene, fail) -> None:
-    """A seabed needs a footprint, and no held node may start below it (an anchor sits on or above it)."""
+    """A seabed needs a footprint, and nothing held (a pinned or driven node, a fixed or driven point) may start
+    below it (an anchor sits on or above it)."""
     bed = scene.seabed
     if bed is None:
         return
-    if bed.contact_width is None and scene.rope.diameter is None:
-        fail("seabed.contact_width", "missing: the seabed pushes on a footprint contact_width x node length; give "
-                                     "it, or rope.diameter")
-    from .shapes import initial_positions
+    if scene.is_system:
+        bare = [i for i, line in enumerate(scene.lines) if line.diameter is None]
+        if bed.contact_width is None and bare:
+            fail("seabed.contact_width", f"missing: the seabed pushes on a footprint contact_width x node length; "
+                                         f"give it, or every line's diameter (lines.{bare[0]} has none)")
+        held = [(f"{p.kind} point '{p.id}' (points.{j}, at y = {p.position[1]:.6g} m)", p.position[0], p.position[1])
+                for j, p in enumerate(scene.points) if p.kind in ("fixed", "driven")]
+    else:
+        if bed.contact_width is None and scene.rope.diameter is None:
+            fail("seabed.contact_width", "missing: the seabed pushes on a footprint contact_width x node length; "
+                                         "give it, or rope.diameter")
+        from .shapes import initial_positions
 
-    x = initial_positions(scene)   # the held nodes where the scene puts them (the sagging guess keeps its ends)
+        x = initial_positions(scene)   # the held nodes where the scene puts them (the sagging guess keeps its ends)
+        nodes = set(scene.pinned.nodes if scene.pinned else ()) | {i for d in scene.driven for i in d.nodes}
+        held = [(f"held node {i} (at y = {x[1][i]:.6g} m)", x[0][i], x[1][i])
+                for i in sorted(scene.node(i) for i in nodes)]
     slope = math.radians(bed.slope)
-    below = (bed.height + math.tan(slope) * x[0] - x[1]) * math.cos(slope)
-    held = set(scene.pinned.nodes if scene.pinned else ()) | {i for d in scene.driven for i in d.nodes}
-    for i in sorted(scene.node(i) for i in held):
-        if below[i] > 1e-9 * max(1.0, abs(bed.height)):
-            fail("seabed.height", f"puts the seabed {below[i]:.6g} m above held node {i} (at y = {x[1][i]:.6g} m): "
-                                  f"an anchor sits on the seabed or above it")
+    for what, x, y in held:
+        below = (bed.height + math.tan(slope) * x - y) * math.cos(slope)
+        if below > 1e-9 * max(1.0, abs(bed.height)):
+            fail("seabed.height", f"puts the seabed {below:.6g} m above {what}: an anchor sits on the seabed or "
+                                  f"above it")
 
 
 PER_NODE_KEYS = ("nodes", "segment_length", "stiffness", "mass")
 PHYSICAL_KEYS = ("length", "segments", "mass_per_length", "density", "EA")
-AGREE = 1e-9   # relative: a resolved scene's derived values agree with their physical form to rounding
 
 
 def _resolve_rope(rope: S.Rope, source: str) -> S.Rope:
@@ -365,7 +379,7 @@ def _resolve_rope(rope: S.Rope, source: str) -> S.Rope:
         for key in PER_NODE_KEYS:
             if getattr(rope, key) is None:
                 spec = {f.name: f.metadata["spec"] for f in fields(S.Rope)}[key]
-                fail(key, f"missing: {spec.doc}{_unit(spec)}; or give the rope in physical units (length, "
+                fail(key, f"missing: {spec.doc}{unit_of(spec)}; or give the rope in physical units (length, "
                           f"segments, mass_per_length, EA)")
         return replace(rope, compression=True if rope.compression is None else rope.compression)
     for key in ("length", "EA"):
@@ -383,62 +397,47 @@ def _resolve_rope(rope: S.Rope, source: str) -> S.Rope:
     if rope.closed and segments < 3 or segments < 1:
         fail("segments", f"a {'closed loop needs at least 3' if rope.closed else 'line needs at least 1'}, "
                          f"got {segments}")
-    per_metre = rope.mass_per_length
-    if rope.density is not None:
-        if rope.diameter is None:
-            fail("diameter", "missing: with density, the mass per metre is density x pi d^2 / 4")
-        from_density = rope.density * math.pi * rope.diameter ** 2 / 4.0
-        if per_metre is not None and not _agree(per_metre, from_density):
-            fail("mass_per_length", f"{per_metre:g} kg/m contradicts density x pi d^2 / 4 = {from_density:g} kg/m; "
-                                    f"give one of them")
-        per_metre = from_density if per_metre is None else per_metre
-    if per_metre is None:
-        fail("mass_per_length", "missing: give mass_per_length, or diameter and density")
-    l0 = rope.length / segments
-    derived = {"nodes": segments if rope.closed else segments + 1, "segment_length": l0,
-               "stiffness": rope.EA / l0, "mass": per_metre * l0}
+    per_metre = mass_per_length(rope.mass_per_length, rope.diameter, rope.density, fail)
+    derived = {"nodes": segments if rope.closed else segments + 1,
+               **per_node(rope.length, segments, rope.EA, per_metre, fail)}
     for key, value in derived.items():
         given = getattr(rope, key)
-        if given is not None and not _agree(given, value):
+        if given is not None and not agree(given, value):
             fail(key, f"{given:g} contradicts the physical form, which gives {value:g}; give one form, or both "
                       f"consistently")
-    origin = {"segment_length": ("length", "length / segments"), "stiffness": ("EA", "EA / l"),
-              "mass": ("mass_per_length", "mass_per_length x l")}
-    for key, (physical, how) in origin.items():   # the derived per-node values obey the per-node keys' limits
-        value, spec = derived[key], {f.name: f.metadata["spec"] for f in fields(S.Rope)}[key]
-        if not MIN_POSITIVE <= value <= MAX_MAGNITUDE:
-            fail(physical, f"gives {key} = {how} = {value:g}{_unit(spec)}, outside {MIN_POSITIVE:g} to "
-                           f"{MAX_MAGNITUDE:g} (its products and ratios would overflow)")
     return replace(rope, segments=segments, mass_per_length=per_metre,
                    compression=False if rope.compression is None else rope.compression, **derived)
 
 
-def _agree(a: float, b: float) -> bool:
-    return abs(a - b) <= AGREE * max(abs(a), abs(b))
-
-
 def _check_fluid(scene: S.Scene, fail) -> None:
     """The fluid terms have what they act with: a fluid, a diameter, gravity for buoyancy, a drag for a flow."""
-    needs_fluid = [k for k in ("fluid_drag", "buoyancy", "added_mass") if getattr(scene, k) is not None]
-    if any(b.volume > 0 or b.cd_area > 0 for b in scene.bodies):
-        needs_fluid.append("bodies")
+    tables = [k for k in ("fluid_drag", "buoyancy", "added_mass") if getattr(scene, k) is not None]
+    parts = _fluid_parts(scene)
+    needs_fluid = tables + [key for key, uses, _, _ in parts if uses]
     if needs_fluid and scene.fluid is None:
         fail(needs_fluid[0], "needs a [fluid] table with the fluid's density (air 1.225, sea water 1025 kg/m^3)")
-    for key in ("fluid_drag", "buoyancy", "added_mass"):
-        if getattr(scene, key) is not None and scene.rope.diameter is None:
+    for key in tables:
+        if not scene.is_system and scene.rope.diameter is None:
             fail("rope.diameter", f"missing: [{key}] acts on the rope's diameter")
+        for i, line in enumerate(scene.lines):
+            if line.diameter is None:
+                fail(f"lines.{i}.diameter", f"missing: [{key}] acts on each line's diameter; give it on the line or "
+                                            f"its line type")
     if scene.buoyancy is not None and scene.gravity is None:
         fail("buoyancy", "needs [gravity]: buoyancy is the fluid's weight displaced")
     drags = [k for k in ("drag", "fluid_drag", "viscous_drag") if getattr(scene, k) is not None]
     inertia = scene.flow is not None and scene.flow.ramp_time > 0 and (
-        scene.buoyancy is not None or scene.added_mass is not None or any(b.ca > 0 for b in scene.bodies))
-    if scene.flow is not None and not drags and not inertia and not any(b.cd_area > 0 for b in scene.bodies):
-        fail("flow", "moves the rope only through drag (and, while it ramps in, through buoyancy or added "
-                     "mass): add [drag], [fluid_drag], [viscous_drag] or a body "
-                     "with cd_area")
+        scene.buoyancy is not None or scene.added_mass is not None or any(a for _, _, _, a in parts))
+    if scene.flow is not None and not drags and not inertia and not any(d for _, _, d, _ in parts):
+        fail("flow", "moves the system only through drag (and, while it ramps in, through buoyancy or added mass): "
+                     "add [fluid_drag], [viscous_drag] or a point or body with cd_area" if scene.is_system else
+                     "moves the rope only through drag (and, while it ramps in, through buoyancy or added mass): add "
+                     "[drag], [fluid_drag], [viscous_drag] or a body with cd_area")
     flow = scene.flow
     if flow is not None:
         _check_flow(flow, scene.dimension, fail)
+    if scene.is_system:
+        return
     index = _node_index(scene.rope.nodes, fail)
     seen: dict[int, str] = {}
     for j, body in enumerate(scene.bodies):
@@ -450,6 +449,20 @@ def _check_fluid(scene: S.Scene, fail) -> None:
             fail(f"bodies.{j}", "has no mass, volume or cd_area; give at least one")
         if body.ca > 0 and body.volume == 0:
             fail(f"bodies.{j}.ca", "an added-mass coefficient needs the body's volume")
+
+
+def _fluid_parts(scene: S.Scene) -> list[tuple[str, bool, bool, bool]]:
+    """The bodies and points the fluid acts on: (key, uses the fluid, feels drag, feels a flow's acceleration)."""
+    if not scene.is_system:
+        return [("bodies", b.volume > 0 or b.cd_area > 0, b.cd_area > 0, b.ca > 0) for b in scene.bodies]
+    parts = [(f"points.{j}.{'volume' if p.volume > 0 else 'cd_area'}", p.volume > 0 or p.cd_area > 0, p.cd_area > 0,
+              p.ca > 0) for j, p in enumerate(scene.points) if p.kind == "free"]
+    for j, b in enumerate(scene.rigid_bodies):
+        used = [k for k in ("volume", "cd_area", "cd_rotation", "added_mass", "added_inertia")
+                if any(v != 0 for v in (getattr(b, k) if isinstance(getattr(b, k), tuple) else (getattr(b, k),)))]
+        parts.append((f"bodies.{j}.{used[0] if used else 'volume'}", bool(used),
+                      bool({"cd_area", "cd_rotation"} & set(used)), bool({"added_mass", "added_inertia"} & set(used))))
+    return parts
 
 
 def _check_flow(flow: S.Flow, dim: int, fail) -> None:
@@ -467,31 +480,30 @@ def _check_flow(flow: S.Flow, dim: int, fail) -> None:
             fail("flow.velocities", f"has {len(flow.velocities)} rows but flow.heights has {len(flow.heights)}; "
                                     f"give one velocity per height")
         if any(b <= a for a, b in zip(flow.heights, flow.heights[1:])):
-            fail("flow.heights", f"must increase strictly, got {_show(list(flow.heights))}")
+            fail("flow.heights", f"must increase strictly, got {show(list(flow.heights))}")
 
 
-def _check_flow_covers_the_rope(scene: S.Scene, fail) -> None:
-    """A table profile must cover the heights the rope starts at (beyond its rows the flow is held constant)."""
+def _check_flow_covers_the_start(scene: S.Scene, fail) -> None:
+    """A table profile must cover the heights the rope starts at (beyond its rows the flow is held constant); in a
+    system, the heights of its points (those on bodies: their bodies' reference points) and bodies."""
     flow = scene.flow
     if flow is None or flow.profile != "table":
         return
-    from .shapes import initial_positions
+    if scene.is_system:
+        y = [p.position[1] for p in scene.points if p.kind != "body"] + [b.position[1] for b in scene.rigid_bodies]
+        what, whose = "system's points and bodies start", "system"
+    else:
+        from .shapes import initial_positions
 
-    y = initial_positions(scene)[1]
-    low, high = float(y.min()), float(y.max())
+        y, what, whose = initial_positions(scene)[1], "rope starts", "rope"
+    low, high = float(min(y)), float(max(y))
     if low < flow.heights[0] or high > flow.heights[-1]:
-        fail("flow.heights", f"cover y = {flow.heights[0]:g} to {flow.heights[-1]:g} m, but the rope starts at "
-                             f"y = {low:g} to {high:g} m; extend the table to the rope's range")
+        fail("flow.heights", f"cover y = {flow.heights[0]:g} to {flow.heights[-1]:g} m, but the {what} at "
+                             f"y = {low:g} to {high:g} m; extend the table to the {whose}'s range")
 
 
 def _check_name_and_length(scene: S.Scene, fail) -> None:
-    name = scene.name
-    if not name or name in (".", "..") or "/" in name or "\\" in name or not name.isprintable():
-        fail("name", f"must be a plain folder name (runs go to runs/<name>/): printable, without / or \\, "
-                     f"not '.' or '..'; got {_show(name)}")
-    if len(name.encode("utf-8")) > MAX_NAME_BYTES:
-        fail("name", f"must be at most {MAX_NAME_BYTES} bytes in UTF-8 (it names the run folder), got "
-                     f"{len(name.encode('utf-8'))}")
+    check_name(scene.name, "name", fail)
     steps = scene.integrator.t_end / scene.integrator.dt
     if steps > MAX_STEPS:
         fail("integrator.t_end", f"t_end / dt = {steps:.3g} steps; at most {MAX_STEPS:.0e} are allowed "
@@ -654,140 +666,3 @@ def _resolve_omegas(scene: S.Scene, fail) -> S.Scene:
             guide = replace(guide, omega0=scene.thrower.omega0)
         guides.append(guide)
     return replace(scene, guides=tuple(guides))
-
-
-# ------------------------------------------------------------------------------ single values
-
-
-def _value(value: Any, sp: S.Spec, key: str, source: str, dim: int):
-    def bad(what):
-        raise SceneError(source, key, f"{what}{_unit(sp)}, got {_show(value)}")
-
-    if sp.kind == "bool":
-        if not isinstance(value, bool):
-            bad("must be true or false")
-        return value
-    if sp.kind == "str":
-        if not isinstance(value, str):
-            bad(f"must be one of {_choices(sp.choices)}" if sp.choices else "must be a string")
-        if len(value) > MAX_TEXT:
-            raise SceneError(source, key, f"must be at most {MAX_TEXT} characters, got {len(value):,}")
-        if sp.choices and value not in sp.choices:
-            near = difflib.get_close_matches(value, sp.choices, n=1)
-            hint = f" (did you mean '{near[0]}'?)" if near else ""
-            raise SceneError(source, key, f"must be one of {_choices(sp.choices)}, got {_show(value)}{hint}")
-        return value
-    if sp.kind == "int":
-        if isinstance(value, bool) or not isinstance(value, int):
-            bad(f"must be one of {_choices(sp.choices)}" if sp.choices else f"must be {_range(sp, 'an integer')}")
-        if sp.choices and value not in sp.choices:
-            bad(f"must be one of {_choices(sp.choices)}")
-        _bounds(value, sp, key, source, "an integer")
-        return value
-    if sp.kind == "float":
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            bad(f"must be {_range(sp, 'a number')}")
-        if not _finite(value):
-            bad("must be a finite number")
-        value = float(value)
-        _bounds(value, sp, key, source, "a number")
-        _magnitude(value, sp, key, source)
-        return value
-    if sp.kind == "vector":
-        return _vector(value, dim, key, source, sp)
-    if sp.kind == "int_list":
-        if isinstance(value, int) and not isinstance(value, bool):
-            value = [value]
-        if not isinstance(value, list) or not value or not all(
-                isinstance(v, int) and not isinstance(v, bool) for v in value):
-            bad("must be a non-empty list of node indices (integers)")
-        return tuple(value)
-    if sp.kind == "float_list":
-        if not isinstance(value, list) or not value or not all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) and _finite(v) for v in value):
-            bad("must be a non-empty list of finite numbers")
-        for v in value:
-            _magnitude(float(v), sp, key, source, shown=value)
-        return tuple(float(v) for v in value)
-    if sp.kind == "points":
-        if not isinstance(value, list) or not value:
-            bad(f"must be a list of points, each a list of {dim} numbers")
-        return tuple(_vector(p, dim, f"{key}[{i}]", source, sp) for i, p in enumerate(value))
-    if sp.kind == "rows":
-        ok = isinstance(value, list) and value and all(
-            isinstance(row, list) and len(row) == dim + 1 and all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) and _finite(v) for v in row) for row in value)
-        if not ok:
-            bad(f"must be a list of rows, each {dim + 1} finite numbers (t, then one per axis)")
-        if len(value) > MAX_PATH_ROWS:
-            raise SceneError(source, key, f"must be at most {MAX_PATH_ROWS:,} rows, got {len(value):,}")
-        for row in value:
-            for v in row:
-                _magnitude(float(v), sp, key, source, shown=row)
-        return tuple(tuple(float(v) for v in row) for row in value)
-    raise AssertionError(sp.kind)
-
-
-def _vector(value, dim, key, source, sp):
-    ok = isinstance(value, list) and len(value) == dim and all(
-        isinstance(v, (int, float)) and not isinstance(v, bool) and _finite(v) for v in value)
-    if not ok:
-        raise SceneError(source, key, f"must be a list of {dim} finite numbers (dimension = {dim}){_unit(sp)}, "
-                                      f"got {_show(value)}")
-    vector = tuple(float(v) for v in value)
-    for v in vector:
-        _magnitude(v, sp, key, source, shown=value)
-    return vector
-
-
-def _finite(v) -> bool:
-    try:
-        return math.isfinite(v)
-    except OverflowError:  # an integer beyond the float range
-        return False
-
-
-def _bounds(value, sp: S.Spec, key, source, what):
-    low_ok = sp.low is None or (value > sp.low if sp.open_low else value >= sp.low)
-    high_ok = sp.high is None or value <= sp.high
-    if not (low_ok and high_ok):
-        raise SceneError(source, key, f"must be {_range(sp, what)}{_unit(sp)}, got {_show(value)}")
-
-
-def _magnitude(value: float, sp: S.Spec, key, source, shown: Any = None):
-    """Refuse numbers whose products would overflow: |value| <= MAX_MAGNITUDE, and >= MIN_POSITIVE when > 0 is
-    required (the products and ratios of a few such numbers stay far inside the float range)."""
-    if abs(value) > MAX_MAGNITUDE:
-        raise SceneError(source, key, f"must be at most {MAX_MAGNITUDE:g} in magnitude{_unit(sp)} (larger numbers "
-                                      f"overflow in products), got {_show(value if shown is None else shown)}")
-    if sp.open_low and sp.low == 0 and value < MIN_POSITIVE:
-        raise SceneError(source, key, f"must be at least {MIN_POSITIVE:g}{_unit(sp)} (smaller ones make ratios "
-                                      f"such as k / m overflow), got {_show(value if shown is None else shown)}")
-
-
-def _range(sp: S.Spec, what: str) -> str:
-    parts = []
-    if sp.low is not None:
-        parts.append(f"{'>' if sp.open_low else '>='} {sp.low:g}")
-    if sp.high is not None:
-        parts.append(f"<= {sp.high:g}")
-    return f"{what} {' and '.join(parts)}" if parts else what
-
-
-def _unit(sp: S.Spec) -> str:
-    return f" [{sp.unit}]" if sp.unit else ""
-
-
-def _choices(choices) -> str:
-    return ", ".join(repr(c) if isinstance(c, str) else str(c) for c in choices)
-
-
-def _unknown(key: str, allowed: list[str], what: str) -> str:
-    near = difflib.get_close_matches(str(key), allowed, n=1, cutoff=0.6)
-    hint = f"did you mean '{near[0]}'? " if near else ""
-    return f"unknown key, not {what}; {hint}allowed: {', '.join(allowed)}"
-
-
-def _show(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."

@@ -25,7 +25,9 @@ class Spec:
     "points" (a list of vectors) or "rows" (a table: rows of a time and one number per dimension); for rigid
     bodies "angles" (one number per axis of rotation: 3 in 3-D, 1 in 2-D), "dofs" (a vector, then its angles:
     6 in 3-D, 3 in 2-D), "dof_rows" (rows of a time and the dofs) and "inertia" (3-D: 3 principal moments or 6,
-    Ixx Iyy Izz Ixy Ixz Iyz; 2-D: 1). ``low``/``high`` bound numbers (``open_low`` makes the lower bound
+    Ixx Iyy Izz Ixy Ixz Iyz, the entries of the symmetric tensor [[Ixx, Ixy, Ixz], [Ixy, Iyy, Iyz], [Ixz, Iyz,
+    Izz]], which must be positive definite; 2-D: 1). A kind of one number (the angle of a 2-D body) may be
+    written bare. ``low``/``high`` bound numbers (``open_low`` makes the lower bound
     strict).
     """
 
@@ -369,12 +371,14 @@ class Point:
     kind: str | None = spec("str", "fixed, free, driven, or body (default: body when a body is named, else "
                                    "fixed)", default=None, required=False, choices=POINT_KINDS)
     body: str | None = spec("str", "the rigid body it is fixed on (kind = body)", default=None, required=False)
-    mass: float = spec("float", "free point: its own mass (a clump weight, a connector)", "kg", default=0.0,
-                       low=0)
-    volume: float = spec("float", "free point: its displaced volume (buoyancy, added mass)", "m^3", default=0.0,
-                         low=0)
-    cd_area: float = spec("float", "free point: drag coefficient times area, CdA", "m^2", default=0.0, low=0)
-    ca: float = spec("float", "free point: added-mass coefficient (on its volume)", default=0.0, low=0)
+    mass: float | None = spec("float", "free point: its own mass (a clump weight, a connector)", "kg", default=None,
+                              required=False, low=0)
+    volume: float | None = spec("float", "free point: its displaced volume (buoyancy, added mass)", "m^3",
+                                default=None, required=False, low=0)
+    cd_area: float | None = spec("float", "free point: drag coefficient times area, CdA", "m^2", default=None,
+                                 required=False, low=0)
+    ca: float | None = spec("float", "free point: added-mass coefficient (on its volume)", default=None,
+                            required=False, low=0)
     velocity: tuple | None = spec("vector", "driven: the constant velocity V", "m/s", default=None, required=False)
     amplitude: tuple | None = spec("vector", "driven: sinusoid amplitude A per axis", "m", default=None,
                                    required=False)
@@ -385,8 +389,8 @@ class Point:
                             default=None, required=False)
     path_table: tuple | None = spec("rows", "driven: the path inline, rows [t, dx, dy(, dz)]", "s, m",
                                     default=None, required=False)
-    ramp_time: float = spec("float", "driven: time over which the sinusoid and the path ramp in (0: at once)",
-                            "s", default=0.0, low=0)
+    ramp_time: float | None = spec("float", "driven: time over which the sinusoid and the path ramp in (0: at once)",
+                                   "s", default=None, required=False, low=0)
 
     @property
     def moving(self) -> bool:
@@ -419,7 +423,8 @@ class RigidBody:
     center_of_gravity: tuple | None = spec("vector", "its centre of gravity, in its frame", "m", default=None,
                                            required=False)
     inertia: tuple | None = spec("inertia", "its moments of inertia about the centre of gravity, in body axes: "
-                                            "Ixx Iyy Izz (3-D, optionally then Ixy Ixz Iyz) or Izz (2-D)",
+                                            "Ixx Iyy Izz (3-D, optionally then the tensor's off-diagonal entries "
+                                            "Ixy Ixz Iyz, Ixy = -integral of x y dm) or Izz (2-D)",
                                  "kg m^2", default=None, required=False)
     volume: float = spec("float", "its displaced volume (buoyancy)", "m^3", default=0.0, low=0)
     center_of_buoyancy: tuple | None = spec("vector", "the centre of its displaced volume, in its frame", "m",
@@ -446,8 +451,8 @@ class RigidBody:
                                    "(m, deg)", default=None, required=False)
     path_table: tuple | None = spec("dof_rows", "driven: the path inline, rows [t, then one value per degree of "
                                                 "freedom]", "s, m, deg", default=None, required=False)
-    ramp_time: float = spec("float", "driven: time over which the sinusoid and the path ramp in (0: at once)",
-                            "s", default=0.0, low=0)
+    ramp_time: float | None = spec("float", "driven: time over which the sinusoid and the path ramp in (0: at once)",
+                                   "s", default=None, required=False, low=0)
 
     @property
     def moving(self) -> bool:
@@ -558,7 +563,8 @@ INITIAL_SHAPES = {
     "equilibrium": EquilibriumStart,
     "from_run": FromRunStart,
 }
-InitialShape = HangingStart | LineStart | SquareLoopStart | PointsStart | EquilibriumStart
+InitialShape = (HangingStart | LineStart | SquareLoopStart | PointsStart | EquilibriumStart | StraightLinesStart
+                | SystemEquilibriumStart)
 
 
 # ---------------------------------------------------------------------- nodes held or overridden
@@ -778,6 +784,8 @@ ARRAYS_OF_TABLES = {"guides": Guide, "driven": Driven, "overrides": NodeOverride
                     "points": Point}
 """``[[bodies]]`` holds a rope's point bodies (an entry with ``node``, :class:`Body`) or a system's rigid bodies
 (an entry with ``id``, :class:`RigidBody`, kept in ``Scene.rigid_bodies``)."""
+SYSTEM_VARIANTS = {"bodies": RigidBody}
+"""Arrays of tables whose entries are of another class in a system: ``[[bodies]]`` are rigid bodies there."""
 NAMED_TABLES = {"line_types": LineType}
 """Tables of named tables: ``[line_types.chain]``, ``[line_types.polyester]``, ..."""
 REQUIRED_TABLES = ("rope", "initial", "integrator")
@@ -785,6 +793,8 @@ SYSTEM_REQUIRED_TABLES = ("lines", "points", "integrator")
 ROPE_ONLY_TABLES = ("rope", "pinned", "driven", "overrides", "thrower", "guides", "drag", "bending")
 """What a system has no use for: parts of one rope's nodes, the string shooter, and the per-node linear drag
 and second-neighbour springs of the course's form (a system's lines are given in physical units)."""
+SYSTEM_ONLY_TABLES = ("points", "line_types")
+"""What only a system has (besides its ``[[lines]]``, which make a scene a system, and its rigid bodies)."""
 
 
 def scene_to_dict(scene: Scene) -> dict:
