@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.build import Model, spring_count
+from ..model.build import Model
 from ..integrate.base import stable_step
 from ..integrate.methods import METHODS, get_method
 from ..model.terms import declared_terms
@@ -35,23 +35,34 @@ SPECTRAL_MAX_NODES = 800
 WARN_FRACTION = 0.8       # `ropesim run` warns above this fraction of the bound, refuses above the bound
 
 
+def representatives(model: Model) -> np.ndarray:
+    """Each node's representative (N,) int: itself, or for the line ends on a system's free point the point's
+    first (they move as one, :mod:`ropesim.model.junctions`)."""
+    rep = np.arange(model.nodes)
+    start, nodes = model.params.junctions.start, model.params.junctions.nodes
+    for j in range(len(start) - 1):
+        group = nodes[start[j]:start[j + 1]]
+        rep[group] = group[0]
+    return rep
+
+
 def _laplacian_rows(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(i, j, k) of every spring between two free nodes, and the diagonal (N,) of L (every term's springs)."""
-    n = model.nodes
-    diag = np.zeros(n)
+    """(i, j, k) of every spring between two free nodes, and the diagonal (N,) of L (every term's springs), the
+    nodes that move together counted as one (their representative's row, :func:`representatives`)."""
+    rep = representatives(model)
+    diag = np.zeros(model.nodes)
     ii, jj, kk = [], [], []
-    pairs = [pair for term in declared_terms(model.scene) for pair in (term.springs(model) or ())]
-    for stride, k in pairs:
-        i = np.arange(spring_count(n, stride, model.scene.rope.closed))
-        j = (i + stride) % n
+    springs = [pair for term in declared_terms(model.scene) for pair in (term.springs(model) or ())]
+    for i, j, k in springs:
+        i, j = rep[i], rep[j]
         keep = i != j
-        i, j = i[keep], j[keep]
+        i, j, k = i[keep], j[keep], k[keep]
         np.add.at(diag, i, k)
         np.add.at(diag, j, k)
         both = ~model.held[i] & ~model.held[j]
         ii.append(i[both])
         jj.append(j[both])
-        kk.append(np.full(both.sum(), k))
+        kk.append(k[both])
     return np.concatenate(ii), np.concatenate(jj), np.concatenate(kk), diag
 
 
@@ -69,9 +80,18 @@ def explicit_damping(model: Model) -> float:
 
 def inertial_mass(model: Model) -> np.ndarray:
     """Each node's mass [kg] as its stiffest mode sees it: its own, plus the smaller of its normal and
-    tangential added mass (the direction in which the fluid adds least inertia oscillates fastest)."""
+    tangential added mass (the direction in which the fluid adds least inertia oscillates fastest); nodes that
+    move together all on their representative (:func:`representatives`), the others' entries left as theirs."""
     added = model.params.added_mass
-    return model.mass + added.min(axis=0) if added.size else model.mass
+    mass = model.mass + added.min(axis=0) if added.size else model.mass
+    junctions = model.params.junctions
+    if junctions.nodes.size:
+        rep = representatives(model)
+        together = np.zeros(model.nodes)
+        np.add.at(together, rep, mass)
+        np.add.at(together, rep[junctions.nodes], junctions.added.min(axis=0))   # left out of the per-node pass
+        mass = np.where(rep == np.arange(model.nodes), together, mass)
+    return mass
 
 
 def gershgorin_frequency(model: Model) -> float:

@@ -6,7 +6,8 @@ import numpy as np
 
 from .. import __version__
 from ..model.build import Model
-from ..model.forces.springs import pair_spring_stretch
+from ..model.forces.springs import segment_strains
+from ..model.tension import line_segments
 from ..model.energy import energy_terms
 from .ledger import ledger_series, ledger_summary
 from .stability import predicted_dt
@@ -30,11 +31,10 @@ def clean_time(t: float) -> float:
 def largest_stretch(model: Model, x: np.ndarray) -> tuple[float, float]:
     """The largest relative spring stretch |r| / l - 1 over all saved frames (a peak between two frames is not
     seen), and the frame index where it occurs."""
-    rope = model.scene.rope
     best, where = -np.inf, 0
     block = block_frames(x[0].nbytes)
     for start in range(0, len(x), block):
-        stretch = pair_spring_stretch(x[start:start + block], rope.segment_length, 1, rope.closed)
+        stretch = segment_strains(model, x[start:start + block])
         per_frame = stretch.max(axis=1)
         k = int(np.argmax(per_frame))
         if per_frame[k] > best:
@@ -78,7 +78,12 @@ def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray
             summary["energy_ledger"] = ledger_summary(ledger_series(model, x, v, outcome.ledger, outcome.energy0),
                                                       outcome.energy0)
             if tension is not None and len(tension):
-                summary["tension"] = tension_figures(t, tension, block_frames(tension[0].nbytes))
+                block = block_frames(tension[0].nbytes)
+                if scene.is_system:
+                    summary["lines"] = {line.id: tension_figures(t, tension[:, part], block)
+                                        for line, part in zip(model.lines, line_segments(model))}
+                else:
+                    summary["tension"] = tension_figures(t, tension, block)
     return summary
 
 
@@ -99,7 +104,7 @@ def _physics_figures(model: Model, t: np.ndarray, x: np.ndarray, v: np.ndarray) 
     }
     if towed_end(scene) is not None:
         out["towed"] = towed_figures(model, x[-1])
-    if scene.thrower is not None and scene.rope.closed:
+    if scene.thrower is not None and scene.rope is not None and scene.rope.closed:
         from .shooter import shooter_figures
 
         out["shooter"] = shooter_figures(model, t, x, v)

@@ -26,6 +26,8 @@ def towed_end(scene: Scene) -> int | None:
     down, says nothing of it), and no bending (neither [bending] nor rope.EI), thrower, guides, seabed,
     moving drive or fluid terms but the linear [drag] (so the steady state above is exact).
     """
+    if scene.is_system:
+        return None
     n = scene.rope.nodes
     held = [scene.node(i) for i in (scene.pinned.nodes if scene.pinned else ())]
     for drive in scene.driven:

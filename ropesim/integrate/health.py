@@ -225,19 +225,18 @@ def limits(model) -> np.ndarray:
 def energy_scale(model) -> float:
     """The energy scale [J] a blow-up is measured against (before the flows are added, see the module doc).
 
-    Initial kinetic and elastic energy, plus the rope's weight times its length (what gravity can convert),
-    plus every spring stretched by 1 % (so a rope at rest in zero gravity still has a scale).
+    Initial kinetic and elastic energy, plus the whole weight times the lines' length (what gravity can
+    convert), plus every spring stretched by 1 % (so a rope at rest in zero gravity still has a scale).
     """
     from ..model.energy import energy_terms
 
-    scene, rope = model.scene, model.scene.rope
+    scene = model.scene
     g = scene.gravity.g if scene.gravity is not None else 0.0
     terms = energy_terms(model, model.x0.T, model.v0.T)
     moving = float(terms["total"] - terms.get("gravity", 0.0))
-    length = rope.nodes * rope.segment_length
-    springs = rope.nodes
-    return abs(moving) + float(model.mass.sum()) * g * length + springs * 0.5 * rope.stiffness * (
-        0.01 * rope.segment_length) ** 2
+    length = sum(line.nodes * line.segment_length for line in model.lines)
+    stretched = sum(line.nodes * 0.5 * line.stiffness * (0.01 * line.segment_length) ** 2 for line in model.lines)
+    return abs(moving) + float(model.mass.sum()) * g * length + stretched
 
 
 def stretch_limit(model) -> float:
@@ -248,7 +247,7 @@ def stretch_limit(model) -> float:
     the longest spring at t = 0, whichever is largest. Stable runs of the built-in scenes stay below 1.7; an
     unstable one that saturates instead of overflowing (bounded garbage) goes past it within a few steps.
     """
-    from ..model.forces.springs import pair_spring_stretch
+    from ..model.forces.springs import segment_strains
 
     scene, rope = model.scene, model.scene.rope
     g = scene.gravity.g if scene.gravity is not None else 0.0
@@ -258,5 +257,6 @@ def stretch_limit(model) -> float:
     if scene.thrower is not None:
         in_box = min(rope.nodes, scene.thrower.length / rope.segment_length + 1)
         load += in_box * scene.thrower.b_thrower * abs(scene.thrower.v_max)
-    initial = float(np.max(pair_spring_stretch(model.x0.T, rope.segment_length, 1, rope.closed), initial=0.0)) + 1.0
-    return max(STRETCH_SANITY, 1.0 + STRETCH_SANITY * load / (rope.stiffness * rope.segment_length), 2.0 * initial)
+    initial = float(np.max(segment_strains(model, model.x0.T), initial=0.0)) + 1.0
+    softest = min(line.stiffness * line.segment_length for line in model.lines)   # its strain under the load
+    return max(STRETCH_SANITY, 1.0 + STRETCH_SANITY * load / softest, 2.0 * initial)

@@ -14,14 +14,23 @@ from __future__ import annotations
 import numpy as np
 
 from .forces.fluid import flow_at
-from .forces.springs import pair_spring_stretch, segment_forces
+from .forces.springs import segment_forces, segment_strains
 from .motion import offset
 from .terms import accelerations
 
 
 def segment_count(model) -> int:
-    rope = model.scene.rope
-    return rope.nodes if rope.closed else rope.nodes - 1
+    """How many segments the model's lines have, all together."""
+    return sum(line.segments for line in model.lines)
+
+
+def line_segments(model) -> list[slice]:
+    """Each line's segments in the frames' tension and strain arrays (line after line)."""
+    out, first = [], 0
+    for line in model.lines:
+        out.append(slice(first, first + line.segments))
+        first += line.segments
+    return out
 
 
 def frame_shapes(model) -> dict[str, tuple]:
@@ -35,9 +44,7 @@ def frame_shapes(model) -> dict[str, tuple]:
 def frame_arrays(model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> dict[str, np.ndarray]:
     """{"tension": (F, S) [N], "strain": (F, S) [-], "support": (F, H, D) [N] if any node is held} for frames
     at times t (F,) with positions and velocities x, v (F, N, D)."""
-    rope = model.scene.rope
-    out = {"tension": segment_forces(model, x, v), "strain": pair_spring_stretch(x, rope.segment_length, 1,
-                                                                                   rope.closed)}
+    out = {"tension": segment_forces(model, x, v), "strain": segment_strains(model, x)}
     if model.held_idx.size:
         out["support"] = support_forces(model, t, x, v)
     return out
@@ -76,5 +83,11 @@ def held_linear_drag(model, t: float, x: np.ndarray, v: np.ndarray) -> np.ndarra
 
 
 def end_tensions(model, tension: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The tension [N] at the rope's two ends per frame: its first and last segments (a loop: segment 0 twice)."""
-    return tension[..., 0], tension[..., -1]
+    """The tension [N] at the rope's two ends per frame: its first and last segments (a loop: segment 0 twice);
+    a system's first line's (:func:`line_end_tensions` gives every line's)."""
+    return line_end_tensions(model, tension)[0]
+
+
+def line_end_tensions(model, tension: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Each line's tension [N] at its start and at its end per frame: its first and last segments."""
+    return [(tension[..., part.start], tension[..., part.stop - 1]) for part in line_segments(model)]

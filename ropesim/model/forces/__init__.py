@@ -42,8 +42,8 @@ class Term:
     - ``energy(model, x)``: a conservative term's potential energy [J] for frames x (..., N, D), as NumPy
       (the analyses, the energy ledger's E(t) and the blow-up check's energy scale use it; the compiled check
       uses :func:`ropesim.model.terms.mechanical_energy`, which must agree);
-    - ``springs(model)``: (stride, k [N/m]) pairs this term couples nodes with, for the stability bound's
-      stiffness Laplacian;
+    - ``springs(model)``: the springs this term couples nodes with, for the stability bound's stiffness
+      Laplacian: (i, j, k) arrays, node pairs and their k [N/m] (:func:`ropesim.model.forces.springs.pairs`);
     - ``node_stiffness(model)``: the largest omega^2 [1/s^2] the term adds to a single node (a centring spring);
     - ``damping(model)``: the largest velocity-damping rate [1/s] the term applies, which explicit methods
       must resolve;

@@ -164,23 +164,36 @@ def pair_spring_stretch(x, rest, stride, closed):
 
 def segment_forces(model, x, v) -> np.ndarray:
     """Each segment's axial force [N] (positive in tension) for frames x, v (..., N, D): the spring's
-    k (r - l0) (none while a slack segment is short) plus the axial damping c dr/dt. Segment j joins node j
-    and node j + 1 (node 0 for a loop's last segment)."""
-    rope = model.scene.rope
-    k, rest, c = rope.stiffness, rope.segment_length, (rope.axial_damping or 0.0) / rope.segment_length
+    k (r - l0) (none while a slack segment is short) plus the axial damping c dr/dt. Line after line (a rope is
+    one line); a line's segment j joins its nodes j and j + 1 (its node 0 for a loop's last segment)."""
+    x, v = np.asarray(x), np.asarray(v)
+    return np.concatenate([_line_forces(line, x[..., line.first:line.end, :], v[..., line.first:line.end, :])
+                           for line in model.lines], axis=-1)
+
+
+def _line_forces(line, x, v) -> np.ndarray:
+    """One line's segment forces [N] for its frames x, v (..., n, D) (see :func:`segment_forces`)."""
+    k, rest, c = line.stiffness, line.segment_length, line.axial_damping / line.segment_length
 
     def force(block):
         xb, vb = block[..., :block.shape[-1] // 2], block[..., block.shape[-1] // 2:]
-        d = _deltas(xb, 1, rope.closed)
+        d = _deltas(xb, 1, line.closed)
         r = np.linalg.norm(d, axis=-1)
         f = k * (r - rest)
-        if not rope.compression:
+        if line.slack:
             f = np.maximum(f, 0.0)
         if c:
             unit = d / np.where(r > 0, r, 1.0)[..., None]
-            f = f + c * np.sum(unit * _deltas(vb, 1, rope.closed), axis=-1)
+            f = f + c * np.sum(unit * _deltas(vb, 1, line.closed), axis=-1)
         return f
-    return _by_blocks(force, np.concatenate([np.asarray(x), np.asarray(v)], axis=-1))
+    return _by_blocks(force, np.concatenate([x, v], axis=-1))
+
+
+def segment_strains(model, x) -> np.ndarray:
+    """Each segment's strain r / l0 - 1, line after line, for frames x (..., N, D)."""
+    x = np.asarray(x)
+    return np.concatenate([pair_spring_stretch(x[..., line.first:line.end, :], line.segment_length, 1, line.closed)
+                           for line in model.lines], axis=-1)
 
 
 @jit.kernel
@@ -236,9 +249,19 @@ def _axial_rate(model) -> float:
     return max(rates, default=0.0)
 
 
+def pairs(first: int, nodes: int, stride: int, closed: bool, k: float) -> tuple:
+    """(i, j, k) arrays of the springs (i, i + stride) of a line of ``nodes`` nodes from ``first`` (wrapped round
+    a loop), each of stiffness k [N/m]."""
+    i = np.arange(nodes if closed else max(nodes - stride, 0))
+    j = (i + stride) % nodes
+    keep = i != j
+    return i[keep] + first, j[keep] + first, np.full(int(keep.sum()), k)
+
+
 ROPE = Term(
     "rope", None, _rope_params, lambda: np.zeros((1, 4)), energy=_lines_energy,
-    springs=lambda model: [(1, max(line.stiffness for line in model.lines))], label="spring", reach=1)
+    springs=lambda model: [pairs(line.first, line.nodes, 1, line.closed, line.stiffness) for line in model.lines],
+    label="spring", reach=1)
 """The lines' own springs (i, i + 1): parameters per line, k [N/m], rest length l [m], closed (1) or open (0),
 slack (1)."""
 
@@ -253,5 +276,5 @@ BENDING = Term(
     "bending", WITH_BENDING, _bending_params, lambda: np.zeros(2),
     energy=lambda model, x: pair_spring_energy(x, model.scene.bending.stiffness, 2 * model.scene.rope.segment_length,
                                                2, model.scene.rope.closed),
-    springs=lambda model: [(2, model.scene.bending.stiffness)], reach=2)
+    springs=lambda model: [pairs(0, model.nodes, 2, model.scene.rope.closed, model.scene.bending.stiffness)], reach=2)
 """Second-neighbour springs (i, i + 2), the seed's bending stiffness: parameters k2 [N/m], rest length 2 l [m]."""
