@@ -234,9 +234,11 @@ def test_a_run_folder_does_not_hold_its_frames_in_memory(scenarios, tmp_path, mo
 
 
 @settings(max_examples=60, deadline=None)
-@given(dim=st.sampled_from([2, 3]), n=st.integers(1, 40), closed=st.booleans(), seed=st.integers(0, 2 ** 31))
-def test_vectorised_chain_springs_equal_the_pairwise_springs(dim, n, closed, seed):
-    """set_chain_springs (two vectorised passes, gravity included) = add_pair_springs(stride 1) + gravity."""
+@given(dim=st.sampled_from([2, 3]), n=st.integers(1, 40), closed=st.booleans(), seed=st.integers(0, 2 ** 31),
+       before=st.integers(0, 5), after=st.integers(0, 5))
+def test_vectorised_chain_springs_equal_the_pairwise_springs(dim, n, closed, seed, before, after):
+    """set_chain_springs (two vectorised passes, gravity included) = add_pair_springs(stride 1) + gravity, on a
+    line of n nodes among other nodes (a system's lines follow each other), which it leaves alone."""
     from ropesim.model.forces.springs import add_pair_springs, set_chain_springs
 
     rng = np.random.default_rng(seed)
@@ -247,9 +249,12 @@ def test_vectorised_chain_springs_equal_the_pairwise_springs(dim, n, closed, see
     expected = np.zeros((dim, n))
     add_pair_springs(x, expected, inv_mass, 40.0, 0.3, 1, closed)
     expected[1] -= 9.81
-    got = np.full((dim, n), np.nan)   # overwritten, not added to
-    set_chain_springs(x, got, inv_mass, 40.0, 0.3, closed, 9.81, False)
-    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-10)
+    wide = np.concatenate([rng.normal(size=(dim, before)), x, rng.normal(size=(dim, after))], axis=1)
+    masses = np.concatenate([np.ones(before), inv_mass, np.ones(after)])
+    got = np.full(wide.shape, np.nan)   # overwritten on the line, not added to; left alone elsewhere
+    set_chain_springs(wide, got, masses, 40.0, 0.3, closed, 9.81, False, before, before + n)
+    np.testing.assert_allclose(got[:, before:before + n], expected, rtol=1e-12, atol=1e-10)
+    assert np.isnan(got[:, :before]).all() and np.isnan(got[:, before + n:]).all()
 
 
 @settings(max_examples=40, deadline=None)

@@ -31,7 +31,7 @@ def damping_force(model, vn: float) -> float:
     v = np.zeros_like(x)
     v[1, 1] = vn
     acc = np.zeros_like(x)
-    add_seabed_friction(x, v, acc, 1.0 / model.mass, model.params.seabed, False)
+    add_seabed_friction(x, v, acc, 1.0 / model.mass, model.params.seabed, model.params.neighbours)
     return acc[1, 1] * model.mass[1]
 
 
