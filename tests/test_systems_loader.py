@@ -522,3 +522,12 @@ SYSTEM_KEYS = st.sampled_from(sorted({"lines", "points", "bodies", "line_types",
                                                                   max_size=4), values), min_size=1, max_size=3))
 def test_random_set_overrides_on_systems_are_accepted_or_refused_in_one_line(raw, items):
     _accepted_or_one_line(tomli_w.dumps(raw), set_items(items))
+
+
+def test_a_sweep_knows_a_systems_keys():
+    """`ropesim sweep` reads a key's kind and unit from the schema: a line type's key, a rigid body's, a line's."""
+    from ropesim.sweep.plan import key_spec, parse_axis
+
+    assert key_spec("line_types.chain.EA").unit == "N" and key_spec("bodies.0.inertia").kind == "inertia"
+    assert key_spec("points.2.mass").unit == "kg" and key_spec("bodies.1.node").kind == "int"
+    assert parse_axis("lines.0.segments=10:40:4").values == (10, 20, 30, 40)   # integers, not 10.0 ...
