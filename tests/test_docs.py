@@ -58,15 +58,18 @@ def schema_sections() -> dict[str, list[tuple[str, S.Spec]]]:
     """{section id: [(key, spec)]} for the top-level keys, every table and array of tables, and each initial
     shape, straight from the schema's own lists."""
     out = {"top-level": list(S.TOP_LEVEL_SCALARS.items())}
-    for name, cls in {**S.TABLES, **S.ARRAYS_OF_TABLES}.items():
+    for name, cls in {**S.TABLES, **S.ARRAYS_OF_TABLES, **S.NAMED_TABLES}.items():
         if name == "initial":
-            out["initial"] = [("shape", S.Spec("str", "", choices=tuple(S.INITIAL_SHAPES)))]
-            for shape, shape_cls in S.INITIAL_SHAPES.items():
-                out[f"initial-{shape}"] = [(f.name, f.metadata["spec"]) for f in fields(shape_cls)
-                                           if f.name != "shape"]
+            for section, shapes in (("initial", S.INITIAL_SHAPES), ("initial-system", S.SYSTEM_INITIAL_SHAPES)):
+                out[section] = [("shape", S.Spec("str", "", choices=tuple(shapes)))]
+                for shape, shape_cls in shapes.items():
+                    out[f"{section}-{shape}"] = [(f.name, f.metadata["spec"]) for f in fields(shape_cls)
+                                                 if f.name != "shape"]
         else:
             assert cls is not None, f"[{name}] is a tagged union: teach this test and docs/hooks/reference.py"
             out[name] = [(f.name, f.metadata.get("spec")) for f in fields(cls)]
+    for name, cls in S.SYSTEM_VARIANTS.items():   # [[bodies]] in a system: rigid bodies
+        out[f"{name}-system"] = [(f.name, f.metadata.get("spec")) for f in fields(cls)]
     return out
 
 
@@ -174,9 +177,15 @@ def test_scene_reference_examples_are_valid_scenes():
     base = {"rope": {"nodes": 21, "segment_length": 1.0, "stiffness": 100.0, "mass": 1.0},
             "initial": {"shape": "line", "start": [0.0, 0.0], "end": [20.0, 0.0]},
             "integrator": {"dt": 0.001, "t_end": 0.01}}
+    system = {"points": [{"id": "a", "position": [0.0, 0.0]}, {"id": "b", "position": [20.0, 0.0]}],
+              "lines": [{"id": "l", "start": "a", "end": "b", "length": 21.0, "segments": 20, "EA": 1e6,
+                         "mass_per_length": 1.0}],
+              "integrator": {"dt": 0.001, "t_end": 0.01}}
     for block in blocks:
         fragment = tomllib.loads(block)
-        raw = fragment if "rope" in fragment and "integrator" in fragment else {**copy.deepcopy(base), **fragment}
+        complete = "integrator" in fragment and ("rope" in fragment or "lines" in fragment)
+        start = system if fragment.keys() & {"lines", "points", "line_types"} else base
+        raw = fragment if complete else {**copy.deepcopy(start), **fragment}
         try:
             load(raw, source="docs/reference/scene.md")
         except SceneError as exc:

@@ -8,6 +8,7 @@ import math
 import tomllib
 import warnings
 from dataclasses import fields, replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -28,6 +29,7 @@ from conftest import SCENARIOS
 
 SOURCE = "t.toml"
 SCENARIO_FILES = sorted(SCENARIOS.glob("*.toml"))
+SYSTEM_FILES = sorted((Path(__file__).parent / "data" / "systems").glob("*.toml"))   # lines, points and bodies
 
 # A small valid open rope, and a small valid loop with a thrower; the refusal tests change one thing at a time.
 LINE = {
@@ -67,6 +69,10 @@ def variant(base: dict, **changes) -> dict:
         node = raw
         for part in path:
             node = node[int(part)] if isinstance(node, list) else node.setdefault(part, {})
+        if isinstance(node, list):   # an entry of an array of tables: changed, removed, or added at the end
+            last = int(last)
+            if last == len(node):
+                node.append(None)
         if value is DELETE:
             del node[last]
         else:
@@ -508,7 +514,7 @@ def test_bad_set_is_one_line(item, key, fragment):
 # -------------------------------------------------------------------------------- resolved scene.toml
 
 
-@pytest.mark.parametrize("path", SCENARIO_FILES, ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", SCENARIO_FILES + SYSTEM_FILES, ids=lambda p: p.stem)
 def test_resolved_scene_loads_back_equal_and_is_a_fixed_point(path):
     scene = load_scene(path)
     text = S.scene_to_toml(scene)
@@ -553,8 +559,9 @@ VALID_RAWS = [tomllib.loads(p.read_text()) for p in SCENARIO_FILES] + [LINE, LOO
 def test_the_fuzz_tests_start_from_valid_scenes():
     for raw in VALID_RAWS:
         assert load(raw) is not None
-KEY_WORDS = sorted({*S.TOP_LEVEL_SCALARS, *S.TABLES, *S.ARRAYS_OF_TABLES, "shape",
-                    *(f.name for cls in [*S.TABLES.values(), *S.ARRAYS_OF_TABLES.values(), *S.INITIAL_SHAPES.values()]
+KEY_WORDS = sorted({*S.TOP_LEVEL_SCALARS, *S.TABLES, *S.ARRAYS_OF_TABLES, *S.NAMED_TABLES, "shape",
+                    *(f.name for cls in [*S.TABLES.values(), *S.ARRAYS_OF_TABLES.values(), *S.INITIAL_SHAPES.values(),
+                                         *S.NAMED_TABLES.values(), *S.SYSTEM_VARIANTS.values()]
                       if cls is not None for f in fields(cls))})
 EDGE_NUMBERS = [0, -1, 1, 2, 3, 4, 2 ** 63 - 1, -(2 ** 63), 10 ** 30, 10 ** 400, -(10 ** 400), 1_000_001,
                 0.0, -0.0, 1e-300, 5e-324, 1e300, 1e308, -1e308, math.nan, math.inf, -math.inf, 1e-9, 0.5, -2.5]
@@ -583,9 +590,9 @@ def _is_number(v) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
-def _numbers_changed(draw, change):
-    """A valid scene with one to three of its numbers replaced by ``change(draw, old value)``."""
-    raw = copy.deepcopy(draw(st.sampled_from(VALID_RAWS)))
+def _numbers_changed(draw, change, raws=VALID_RAWS):
+    """A valid scene (one of ``raws``) with one to three of its numbers replaced by ``change(draw, old value)``."""
+    raw = copy.deepcopy(draw(st.sampled_from(raws)))
     numeric = [(box, k) for box, k in _slots(raw) if _is_number(box[k])]
     for _ in range(draw(st.integers(1, 3))):
         box, k = draw(st.sampled_from(numeric))
@@ -594,9 +601,9 @@ def _numbers_changed(draw, change):
 
 
 @st.composite
-def perturbed_scenes(draw):
+def perturbed_scenes(draw, raws=VALID_RAWS):
     """A valid scene with one to three of its numbers replaced by edge values (zero, negative, huge, nan...)."""
-    return _numbers_changed(draw, lambda draw, old: draw(numbers))
+    return _numbers_changed(draw, lambda draw, old: draw(numbers), raws)
 
 
 SCALES = [-1.0, 0.0, 1e-12, 1e-9, 1e-3, 0.1, 10.0, 1e3, 1e9, 1e12]
@@ -613,9 +620,10 @@ def rescaled_scenes(draw):
 
 
 @st.composite
-def mutated_scenes(draw):
-    """A valid scene with one to four random edits: delete, retype, renumber, add unknown keys, nest."""
-    raw = copy.deepcopy(draw(st.sampled_from(VALID_RAWS)))
+def mutated_scenes(draw, raws=VALID_RAWS):
+    """A valid scene (one of ``raws``) with one to four random edits: delete, retype, renumber, add unknown keys,
+    nest."""
+    raw = copy.deepcopy(draw(st.sampled_from(raws)))
     for _ in range(draw(st.integers(1, 4))):
         slots = list(_slots(raw))
         action = draw(st.sampled_from(["delete", "replace", "number", "number", "add", "nest"]))
@@ -637,11 +645,18 @@ def mutated_scenes(draw):
     return raw
 
 
-def _accepted_or_one_line(text: str, sets=()):
+def loaded_or_one_line(text: str, sets=()) -> S.Scene | None:
+    """The scene ``text`` holds, or None when it is refused, in one line."""
     try:
-        scene = scene_from_toml(text, source="fuzz.toml", default_name="fuzz", overrides=sets)
+        return scene_from_toml(text, source="fuzz.toml", default_name="fuzz", overrides=sets)
     except SceneError as exc:
         assert_one_line(exc, "fuzz.toml")
+        return None
+
+
+def _accepted_or_one_line(text: str, sets=()):
+    scene = loaded_or_one_line(text, sets)
+    if scene is None:
         return None
     with warnings.catch_warnings():   # an accepted scene sets up without overflow or invalid-value warnings
         warnings.simplefilter("error")
@@ -678,11 +693,16 @@ def test_scenes_with_edge_numbers_are_accepted_or_refused_in_one_line(raw):
 @given(st.sampled_from(VALID_RAWS), st.lists(st.tuples(st.lists(keys, min_size=1, max_size=4), values),
                                              min_size=1, max_size=3))
 def test_random_set_overrides_are_accepted_or_refused_in_one_line(raw, items):
+    _accepted_or_one_line(tomli_w.dumps(raw), set_items(items))
+
+
+def set_items(items) -> list[str]:
+    """``--set`` strings from (key path, value) pairs: KEY=VALUE, the value written as TOML (a table as {})."""
     sets = []
     for path, value in items:
         text = tomli_w.dumps({"v": value}).partition("=")[2].strip() if not isinstance(value, dict) else "{}"
         sets.append(".".join(path) + "=" + text)
-    _accepted_or_one_line(tomli_w.dumps(raw), sets)
+    return sets
 
 
 @pytest.mark.slow

@@ -38,6 +38,10 @@ KINDS = {
     "int_list": "node indices",
     "points": "list of vectors",
     "rows": "table",
+    "angles": "angles",
+    "dofs": "per degree of freedom",
+    "dof_rows": "table",
+    "inertia": "inertia",
 }
 
 # What a key left out means when the schema's default is None ("work it out from the rest of the scene").
@@ -67,6 +71,47 @@ WHEN_ABSENT = {
     "driven.phase": "zero on every axis",
     "thrower.omega0": "4π |v_max| / L",
     "guides.omega0": "the thrower's ω0 (required without a `[thrower]`)",
+    # systems: a line type, a line (its type's value, else ...), a point, a rigid body
+    "line_types.mass_per_length": "`density` × π d² / 4 when both are given",
+    "line_types.compression": "`false`",
+    "line_types.cd_normal": "`[fluid_drag]`'s",
+    "line_types.cd_tangential": "`[fluid_drag]`'s",
+    "line_types.ca_normal": "`[added_mass]`'s",
+    "line_types.ca_tangential": "`[added_mass]`'s",
+    "lines.type": "none: the line gives its material itself",
+    "lines.diameter": "its type's (none without one)",
+    "lines.mass_per_length": "its type's, else `density` × π d² / 4 (**required** one way or another)",
+    "lines.density": "its type's (none without one)",
+    "lines.EA": "its type's (**required** in one or the other)",
+    "lines.axial_damping": "its type's, else zero",
+    "lines.EI": "its type's, else no bending stiffness",
+    "lines.compression": "its type's, else `false`",
+    "lines.cd_normal": "its type's, else `[fluid_drag]`'s",
+    "lines.cd_tangential": "its type's, else `[fluid_drag]`'s",
+    "lines.ca_normal": "its type's, else `[added_mass]`'s",
+    "lines.ca_tangential": "its type's, else `[added_mass]`'s",
+    "points.kind": '`"body"` when `body` is given, else `"fixed"`',
+    "points.mass": "0 on a free point (other kinds take none)",
+    "points.volume": "0 on a free point (other kinds take none)",
+    "points.cd_area": "0 on a free point (other kinds take none)",
+    "points.ca": "0 on a free point (other kinds take none)",
+    "points.velocity": "zero on a driven point",
+    "points.period": "**required** with `amplitude`",
+    "points.phase": "zero with `amplitude`",
+    "points.ramp_time": "0 on a driven point",
+    "bodies.orientation": "zero: the body's axes along the scene's",
+    "bodies.center_of_gravity": "the body's reference point",
+    "bodies.inertia": "none (**required** for a free body)",
+    "bodies.center_of_buoyancy": "the body's reference point",
+    "bodies.cd_area": "zero",
+    "bodies.cd_rotation": "zero",
+    "bodies.added_mass": "zero",
+    "bodies.added_inertia": "zero",
+    "bodies.velocity": "zero on a driven body",
+    "bodies.angular_velocity": "zero on a driven body",
+    "bodies.period": "**required** with `amplitude`",
+    "bodies.phase": "zero with `amplitude`",
+    "bodies.ramp_time": "0 on a driven body",
 }
 
 
@@ -114,6 +159,10 @@ def allowed(spec) -> str:
         "int_list": "a list of indices, or one; −N to N−1",
         "points": "N vectors",
         "rows": "rows of t and `dimension` numbers, t increasing",
+        "angles": "3 numbers in 3-D (about x, y, z), 1 in 2-D (about z)",
+        "dofs": "6 numbers in 3-D (x, y, z, then about x, y, z), 3 in 2-D (x, y, about z)",
+        "dof_rows": "rows of t and one number per degree of freedom (6 in 3-D, 3 in 2-D), t increasing",
+        "inertia": "3-D: 3 moments > 0, or a positive definite tensor's 6 entries; 2-D: 1 moment > 0",
         "str": "any",
         "int": "any integer",
         "float": "any number",
@@ -165,15 +214,17 @@ def key_table(rows: list[tuple[str, str, object, str]]) -> str:
     return "\n".join(out)
 
 
-def _table_rows(prefix: str, cls) -> list:
-    return [(f"{prefix}.{f.name}", f.name, f.metadata["spec"], default_of(f"{prefix}.{f.name}", f))
+def _table_rows(prefix: str, cls, table: str = "") -> list:
+    """One row per key of ``cls``: anchors ``prefix.KEY``; WHEN_ABSENT is looked up as ``table.KEY`` (default
+    ``prefix``)."""
+    return [(f"{prefix}.{f.name}", f.name, f.metadata["spec"], default_of(f"{table or prefix}.{f.name}", f))
             for f in spec_fields(cls)]
 
 
 def scene_tables() -> list[str]:
     """Every part of a scene file the reference documents, in the order a resolved scene.toml lists them."""
     schema = _schema()
-    return ["top-level", *schema.TABLES, *schema.ARRAYS_OF_TABLES]
+    return ["top-level", *schema.TABLES, *getattr(schema, "NAMED_TABLES", {}), *schema.ARRAYS_OF_TABLES]
 
 
 def scene_section(name: str) -> str:
@@ -186,9 +237,20 @@ def scene_section(name: str) -> str:
         return "## Top-level keys {#top-level}\n\nKeys before the first table.\n\n" + key_table(rows)
     if name in schema.ARRAYS_OF_TABLES:
         cls = schema.ARRAYS_OF_TABLES[name]
-        return (f"## `[[{name}]]` {{#{name}}}\n\n{_docstring(cls)}\n\n"
-                f"An array of tables: write one `[[{name}]]` header per entry. `--set` addresses entry i as "
-                f"`{name}.i.KEY`, counting from 0.\n\n" + key_table(_table_rows(name, cls)))
+        out = (f"## `[[{name}]]` {{#{name}}}\n\n{_docstring(cls)}\n\n"
+               f"An array of tables: write one `[[{name}]]` header per entry. `--set` addresses entry i as "
+               f"`{name}.i.KEY`, counting from 0.\n\n" + key_table(_table_rows(name, cls)))
+        variant = getattr(schema, "SYSTEM_VARIANTS", {}).get(name)
+        if variant is not None:   # the same array's entries in a system: another class, other keys
+            out += (f"\n\n### `[[{name}]]` in a system {{#{name}-system}}\n\nIn a system (a scene with "
+                    f"`[[lines]]`), each `[[{name}]]` entry has these keys instead. {_docstring(variant)}\n\n"
+                    + key_table(_table_rows(f"{name}-system", variant, name)))
+        return out
+    if name in getattr(schema, "NAMED_TABLES", {}):
+        cls = schema.NAMED_TABLES[name]
+        return (f"## `[{name}.NAME]` {{#{name}}}\n\n{_docstring(cls)}\n\n"
+                f"A table of named tables: write one `[{name}.NAME]` header per entry, NAME a plain name without "
+                f"dots. `--set` addresses a key as `{name}.NAME.KEY`.\n\n" + key_table(_table_rows(name, cls)))
     if name not in schema.TABLES:
         raise KeyError(name)
     cls = schema.TABLES[name]
@@ -199,11 +261,12 @@ def scene_section(name: str) -> str:
     return f"## `[{name}]` {{#{name}}}\n\n{status} {_docstring(cls)}\n\n" + key_table(_table_rows(name, cls))
 
 
-def union_shapes(name: str) -> dict:
-    """A tagged-union table (TABLES[name] is None): its tag's values and their dataclasses."""
+def union_shapes(name: str, system: bool = False) -> dict:
+    """A tagged-union table (TABLES[name] is None): its tag's values and their dataclasses (``system``: in a
+    system of lines)."""
     schema = _schema()
     if name == "initial":
-        return dict(schema.INITIAL_SHAPES)
+        return dict(getattr(schema, "SYSTEM_INITIAL_SHAPES", {}) if system else schema.INITIAL_SHAPES)
     raise ValueError(f"scene table [{name}] is a tagged union that docs/hooks/reference.py does not know; "
                      f"teach union_shapes() where its variants are listed")
 
@@ -216,11 +279,26 @@ def _union_section(name: str, status: str) -> str:
                choices=tuple(shapes))
     out = [f"## `[{name}]` {{#{name}}}\n\n{status} The key `shape` chooses one of {len(shapes)} layouts, each "
            f"with its own keys.\n\n" + key_table([(f"{name}.shape", "shape", tag, "**required**")])]
-    for shape, cls in shapes.items():
-        out.append(f"### `shape = \"{shape}\"` {{#{name}-{shape}}}\n\n{_docstring(cls)}\n\n"
-                   + key_table([(f"{name}-{shape}.{f.name}", f.name, f.metadata["spec"],
-                                 default_of(f"{name}.{f.name}", f)) for f in spec_fields(cls)]))
+    out += _shape_sections(name, name, shapes)
+    systems = union_shapes(name, system=True)
+    if systems:
+        tag = Spec("str", "how a system starts", choices=tuple(systems))
+        default = f'`"{next(iter(systems))}"`'
+        out.append(f"### In a system {{#{name}-system}}\n\nA system's `[{name}]` is optional, and so is its "
+                   f"`shape`: it starts as `{next(iter(systems))}` without them. The shapes above start one rope; a "
+                   f"system takes one of these.\n\n" + key_table([(f"{name}-system.shape", "shape", tag, default)]))
+        out += _shape_sections(name, f"{name}-system", systems)
     return "\n\n".join(out)
+
+
+def _shape_sections(name: str, prefix: str, shapes: dict) -> list[str]:
+    out = []
+    for shape, cls in shapes.items():
+        rows = [(f"{prefix}-{shape}.{f.name}", f.name, f.metadata["spec"], default_of(f"{name}.{f.name}", f))
+                for f in spec_fields(cls)]
+        out.append(f"### `shape = \"{shape}\"` {{#{prefix}-{shape}}}\n\n{_docstring(cls)}\n\n"
+                   + (key_table(rows) if rows else "No other keys."))
+    return out
 
 
 # ---------------------------------------------------------------------------------------- command line

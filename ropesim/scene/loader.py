@@ -252,7 +252,7 @@ class _Ctx:
             raise SceneError(self.source, "initial", f"must be a table, got {show(init)}")
         shape_spec = S.Spec("str", "initial shape", choices=tuple(S.SYSTEM_INITIAL_SHAPES))
         shape = init.get("shape", "lines")
-        if shape in S.INITIAL_SHAPES and shape not in S.SYSTEM_INITIAL_SHAPES:
+        if isinstance(shape, str) and shape in S.INITIAL_SHAPES and shape not in S.SYSTEM_INITIAL_SHAPES:
             self.fail("initial.shape", f"'{shape}' starts one rope; a system starts as "
                                        f"{choices_text(S.SYSTEM_INITIAL_SHAPES)} (its points and bodies where the "
                                        f"scene puts them)")

@@ -1,9 +1,11 @@
 """The scene: a validated, frozen description of one simulation.
 
-A scene file is TOML. Each table names one part of the model and a scene names only the parts it uses:
-``[rope]`` (always), ``[initial]`` (always), ``[integrator]`` (always), and optionally ``[gravity]``,
-``[drag]``, ``[bending]``, ``[thrower]``, ``[[guides]]``, ``[pinned]``, ``[[driven]]``, ``[[overrides]]``
-and ``[output]``. Units are SI throughout; x is horizontal and y points up (z is the third axis in 3-D).
+A scene file is TOML. Each table names one part of the model and a scene names only the parts it uses. A
+scene is one rope: ``[rope]``, ``[initial]`` and ``[integrator]`` (always), and optionally ``[gravity]``,
+``[drag]``, ``[bending]``, ``[thrower]``, ``[[guides]]``, ``[pinned]``, ``[[driven]]``, ``[[overrides]]``,
+``[output]`` and the fluid and seabed tables; or a system: ``[[lines]]`` between ``[[points]]``, rigid
+``[[bodies]]``, named ``[line_types.NAME]``, ``[integrator]``, and the same force tables (see "systems"
+below). Units are SI throughout; x is horizontal and y points up (z is the third axis in 3-D).
 
 The dataclasses below are the schema: every field's ``metadata`` holds a :class:`Spec` saying what the TOML
 value may be. :mod:`ropesim.loader` reads a file against them; :func:`scene_to_dict` writes a scene back with
@@ -404,8 +406,9 @@ BODY_KINDS = ("free", "fixed", "driven")
 class RigidBody:
     """A rigid body of a system (a spar, a buoy, a container): 6 degrees of freedom in 3-D, 3 in 2-D (x, y and
     the angle about z). Its frame's origin is its reference point ``position`` (the point its motion and forces
-    are reported at), turned by ``orientation``: rotations about x, then y, then z (3-D; MoorDyn's roll, pitch
-    and yaw, here in ropesim's frame with y up), or the angle about z (2-D). Its mass sits at
+    are reported at), turned by ``orientation``: rotations about x, then y, then z (3-D), or the angle about z
+    (2-D). With y up, the rotation about y turns the body's heading: MoorDyn's point (x, y, z) is ropesim's
+    (x, z, -y), so its roll is about ropesim's x, its pitch about -z and its yaw about y. Its mass sits at
     ``center_of_gravity`` with the inertia ``inertia`` about it in body axes; buoyancy rho V g acts at
     ``center_of_buoyancy``; drag -1/2 rho CdA_i |u| u_i on the velocity u of the reference point relative to
     the flow, in body axes (and -1/2 rho Cd_i |w| w_i on the rotation rate w); added mass and inertia on the

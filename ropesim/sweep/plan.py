@@ -114,9 +114,11 @@ def key_spec(key: str) -> S.Spec | None:
     if len(parts) == 1:
         return S.TOP_LEVEL_SCALARS.get(parts[0])
     head, rest = parts[0], parts[1:]
-    if head in S.ARRAYS_OF_TABLES:
-        classes = [S.ARRAYS_OF_TABLES[head]]
+    if head in S.ARRAYS_OF_TABLES:   # [[bodies]]: a rope's point bodies, or a system's rigid bodies
+        classes = [S.ARRAYS_OF_TABLES[head], *([S.SYSTEM_VARIANTS[head]] if head in S.SYSTEM_VARIANTS else [])]
         rest = rest[1:] if rest[0].isdigit() else rest
+    elif head in S.NAMED_TABLES:     # line_types.NAME.KEY
+        classes, rest = [S.NAMED_TABLES[head]], rest[1:]
     elif head == "initial":
         classes = list(S.INITIAL_SHAPES.values())
     elif S.TABLES.get(head) is not None:
