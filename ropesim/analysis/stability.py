@@ -39,6 +39,8 @@ def representatives(model: Model) -> np.ndarray:
     """Each node's representative (N,) int: itself, or for the line ends on a system's free point the point's
     first (they move as one, :mod:`ropesim.model.junctions`)."""
     rep = np.arange(model.nodes)
+    if model.params.junctions is None:
+        return rep
     start, nodes = model.params.junctions.start, model.params.junctions.nodes
     for j in range(len(start) - 1):
         group = nodes[start[j]:start[j + 1]]
@@ -85,7 +87,7 @@ def inertial_mass(model: Model) -> np.ndarray:
     added = model.params.added_mass
     mass = model.mass + added.min(axis=0) if added.size else model.mass
     junctions = model.params.junctions
-    if junctions.nodes.size:
+    if junctions is not None:
         rep = representatives(model)
         together = np.zeros(model.nodes)
         np.add.at(together, rep, mass)
