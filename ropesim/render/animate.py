@@ -22,7 +22,7 @@ from .encode import ANIMATION_TYPES, GIF_MAX_FPS, gif_fps, write_gif, write_mp4
 from .framing import Projection, figure_inches, followed_nodes, origin, projection, single_view, view_box
 from ..io.atomic import atomic_output
 from .output import output_path
-from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
+from .scene_artist import Geometry, RopeArtist, body_state, legend_handles, style_axes
 from .style import with_picture_text
 from .timeline import animation_plan
 
@@ -37,6 +37,7 @@ class Frames(Protocol):
     scene: Scene
     t: np.ndarray   # (F,) [s]
     x: np.ndarray   # (F, N, D) [m]
+    # and, for a system with rigid bodies, body_x (F, B, D) [m] and body_q (F, B, 4) (read with getattr)
 
 
 @dataclass(frozen=True)
@@ -57,8 +58,8 @@ class FrameRenderer:
         from matplotlib.figure import Figure
 
         self.traj, self.nodes, self.cols = traj, nodes, list(proj.axes)
-        self.layout = layout = single_view(view_box(model, traj.x, proj, nodes), size,
-                                           legend=bool(legend_handles(model)))
+        box = view_box(model, traj.x, proj, nodes, getattr(traj, "body_x", None))
+        self.layout = layout = single_view(box, size, legend=bool(legend_handles(model)))
         self.size = (layout.width, layout.height)
         fig = Figure(figsize=figure_inches(layout.width, layout.height, DPI), dpi=DPI)
         self.canvas = FigureCanvasAgg(fig)
@@ -82,7 +83,7 @@ class FrameRenderer:
             offset = -origin(x, self.nodes)[self.cols]
             self.geometry.move(offset)
         self.canvas.restore_region(self.background)
-        self.rope.show(x, offset)
+        self.rope.show(x, offset, body_state(self.traj, i))
         self.stamp.set_text(f"t = {self.traj.t[i]:.2f} s")
         for artist in self.moving:
             artist.draw(self.canvas.get_renderer())

@@ -18,7 +18,7 @@ from ..model.build import build
 from ..io.trajectory import Trajectory
 from .framing import figure_inches, fit_box, followed_nodes, origin, projection, view_aspect, view_box
 from .output import output_path, save_png
-from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
+from .scene_artist import Geometry, RopeArtist, body_state, legend_handles, style_axes
 from .style import OUTSIDE_RIGHT, with_picture_text
 from .timeline import chosen_frames
 
@@ -69,10 +69,11 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
     model = build(traj.scene)
     proj = projection(view, traj.scene.dimension)
     nodes = followed_nodes(model, follow)
-    box = view_box(model, traj.x, proj, nodes)
+    box = view_box(model, traj.x, proj, nodes, traj.body_x)
     aspect = view_aspect(box)
     box = fit_box(box, 1.0, aspect)
     frames = [np.asarray(traj.x[i]) for i in indices]
+    states = [body_state(traj, i) for i in indices]
     offsets = [None if nodes is None else -origin(x, nodes)[list(proj.axes)] for x in frames]
 
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -94,13 +95,13 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
         ax.set_aspect("equal", adjustable="box")
     shown = [float(traj.t[i]) for i in indices]
     if overlay:
-        _overlay(axes[0], model, proj, frames, offsets, shown)
+        _overlay(axes[0], model, proj, frames, offsets, shown, states)
     else:
-        for ax, x, offset, t in zip(axes, frames, offsets, shown):
+        for ax, x, offset, t, state in zip(axes, frames, offsets, shown, states):
             geometry = Geometry(ax, model, proj)
             if offset is not None:
                 geometry.move(offset)
-            RopeArtist(ax, model, proj).show(x, offset)
+            RopeArtist(ax, model, proj).show(x, offset, state)
             ax.set_title(f"t = {t:.2f} s", fontsize=9, pad=3)
         for ax in axes[len(frames):]:
             ax.set_visible(False)
@@ -117,7 +118,7 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
     return Sheet(path=out, times=tuple(shown), size=(px_width, px_height))
 
 
-def _overlay(ax, model, proj, frames, offsets, times) -> None:
+def _overlay(ax, model, proj, frames, offsets, times, states) -> None:
     """All ``frames`` on ``ax``, fading from light and faint (first) to dark and solid (last)."""
     from matplotlib import colormaps
     from matplotlib.lines import Line2D
@@ -128,8 +129,8 @@ def _overlay(ax, model, proj, frames, offsets, times) -> None:
         geometry.move(offsets[-1])
     fades = np.linspace(*FADE, len(frames)) if len(frames) > 1 else np.array([FADE[1]])
     handles = []
-    for x, offset, t, f in zip(frames, offsets, times, fades):
+    for x, offset, t, f, state in zip(frames, offsets, times, fades, states):
         color = cmap(f)
-        RopeArtist(ax, model, proj, alpha=float(f), color=color).show(x, offset)
+        RopeArtist(ax, model, proj, alpha=float(f), color=color).show(x, offset, state)
         handles.append(Line2D([], [], color=color, alpha=float(f), label=f"t = {t:.2f} s"))
     ax.legend(handles=handles, fontsize=7, **OUTSIDE_RIGHT)

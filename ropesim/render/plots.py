@@ -20,10 +20,11 @@ from ..analysis.summary import block_frames
 from ..model.energy import energy_terms
 from ..analysis.towed import exact_steady_state, segment_angles, shape_verdict, towed_end
 from ..model.build import Model, build
-from ..model.forces.springs import pair_spring_stretch
+from ..model.forces.springs import segment_strains
 from ..io.trajectory import Trajectory
 from .framing import figure_inches, frame_blocks
 from .output import output_path, save_png
+from .scene_artist import legend_handles, line_color
 from .style import OUTSIDE_RIGHT, with_picture_text
 
 DPI = 100
@@ -42,9 +43,8 @@ def per_frame(traj: Trajectory, fn: Callable[[np.ndarray, np.ndarray], np.ndarra
 
 
 def largest_stretch_series(traj: Trajectory, model: Model) -> np.ndarray:
-    """The largest relative stretch |r| / l - 1 of the rope's springs in each frame."""
-    rope = model.scene.rope
-    return per_frame(traj, lambda x, v: pair_spring_stretch(x, rope.segment_length, 1, rope.closed).max(axis=1))
+    """The largest relative stretch |r| / l - 1 of the springs of every line in each frame."""
+    return per_frame(traj, lambda x, v: segment_strains(model, x).max(axis=1))
 
 
 def last_finite_frame(traj: Trajectory) -> int:
@@ -149,42 +149,93 @@ def draw_inclination(ax, traj: Trajectory, model: Model) -> None:
     ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
 
+def end_labels(model: Model) -> list[tuple[str, int]]:
+    """(label, column in the frames' tension array) of every line end: a rope's "segment 0 (at node 0)" and
+    its last segment's; a system's "LINE start (POINT)" and "LINE end (POINT)"."""
+    from ..model.tension import line_segments
+
+    if not model.scene.is_system:
+        last = sum(line.segments for line in model.lines) - 1
+        return [("segment 0 (at node 0)", 0)] + ([(f"segment {last} (the other end)", last)] if last > 0 else [])
+    out = []
+    for line, part in zip(model.scene.lines, line_segments(model)):
+        out += [(f"{line.id} start ({line.start})", part.start), (f"{line.id} end ({line.end})", part.stop - 1)]
+    return out
+
+
 def draw_end_tensions(ax, traj: Trajectory, model: Model) -> None:
-    """The tension in the rope's first and last segments over time."""
+    """The tension in the first and last segment of every line (a rope's two ends) over time."""
     from ..analysis.tension import force_unit
 
-    ends = np.asarray(traj.tension[:, [0, -1]])
+    labels = end_labels(model)
+    ends = np.asarray(traj.tension[:, [column for _, column in labels]])
     unit, scale = force_unit(float(np.nanmax(np.abs(ends), initial=0.0)))
-    ax.plot(traj.t, ends[:, 0] / scale, linewidth=1.1, label="segment 0 (at node 0)")
-    if traj.tension.shape[1] > 1:
-        ax.plot(traj.t, ends[:, 1] / scale, linewidth=1.1, label=f"segment {traj.tension.shape[1] - 1} (the other end)")
+    system = model.scene.is_system
+    for k, (label, _) in enumerate(labels):
+        style = {"color": line_color(k // 2), "linestyle": "-" if k % 2 == 0 else "--"} if system else {}
+        ax.plot(traj.t, ends[:, k] / scale, linewidth=1.1, label=label, **style)
     ax.axhline(0, color="0.6", linewidth=0.8)
     ax.set_ylabel(f"tension [{unit}]")
-    ax.set_title("Tension at the rope's ends")
+    ax.set_title("Tension at every line end" if system else "Tension at the rope's ends")
     ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
 
 def draw_tension_profile(ax, traj: Trajectory, model: Model) -> None:
-    """Tension along the rope at the last frame, and its range over the run."""
+    """Tension along each line (a rope) at the last frame, and its range over the run."""
+    from ..analysis.tension import force_unit
+    from ..model.tension import line_segments
+
     tension = traj.tension
     i = last_finite_frame(traj)
-    along = (np.arange(tension.shape[1]) + 0.5) * model.scene.rope.segment_length
     low, high = np.full(tension.shape[1], np.inf), np.full(tension.shape[1], -np.inf)
     step = block_frames(tension[0].nbytes)
     for s in range(0, len(traj.t), step):
         block = np.asarray(tension[s:s + step])
         low, high = np.minimum(low, np.nanmin(block, axis=0)), np.maximum(high, np.nanmax(block, axis=0))
-    from ..analysis.tension import force_unit
-
     unit, scale = force_unit(float(np.nanmax(np.abs(high), initial=0.0)))
     span = f"t = {traj.t[0]:.3g} .. {traj.t[-1]:.3g} s"
-    ax.fill_between(along, low / scale, high / scale, color="#1f77b4", alpha=0.2, linewidth=0, label=f"range, {span}")
-    ax.plot(along, np.asarray(tension[i]) / scale, "o-", markersize=3, color="#1f77b4", label=f"t = {traj.t[i]:.3g} s")
+    system = model.scene.is_system
+    for k, (line, part) in enumerate(zip(model.lines, line_segments(model))):
+        along = (np.arange(line.segments) + 0.5) * line.segment_length
+        color = line_color(k) if system else "#1f77b4"
+        ax.fill_between(along, low[part] / scale, high[part] / scale, color=color, alpha=0.2, linewidth=0,
+                        label=f"range, {span}" if k == 0 else None)
+        ax.plot(along, np.asarray(tension[i, part]) / scale, "o-", markersize=3, color=color,
+                label=f"{line.id}, t = {traj.t[i]:.3g} s" if system else f"t = {traj.t[i]:.3g} s")
     ax.axhline(0, color="0.6", linewidth=0.8)
-    ax.set_xlabel("distance along the rope from node 0 (at rest) [m]")
+    ax.set_xlabel("distance along each line from its start (at rest) [m]" if system
+                  else "distance along the rope from node 0 (at rest) [m]")
     ax.set_ylabel(f"tension [{unit}]")
-    ax.set_title("Tension along the rope")
+    ax.set_title("Tension along each line (shaded: its range)" if system else "Tension along the rope")
     ax.legend(fontsize=7, **OUTSIDE_RIGHT)
+
+
+def draw_shape(ax, traj: Trajectory, model: Model) -> None:
+    """A system's shape at the last frame, every line in its colour and labelled at its middle, the points and
+    bodies marked; its start in light grey below (a 3-D scene seen from the side, x across and y up)."""
+    from .framing import projection, view_box
+    from .scene_artist import Geometry, RopeArtist, body_state
+
+    proj = projection(None, model.dim)
+    i = last_finite_frame(traj)
+    Geometry(ax, model, proj)
+    RopeArtist(ax, model, proj, color="0.82").show(np.asarray(traj.x[0]), None, body_state(traj, 0))
+    shown = RopeArtist(ax, model, proj)
+    x = np.asarray(traj.x[i])
+    shown.show(x, None, body_state(traj, i))
+    for line in model.lines:
+        middle = x[line.first + line.nodes // 2, list(proj.axes)]
+        ax.annotate(line.id, middle, xytext=(4, 4), textcoords="offset points", fontsize=7, zorder=7,
+                    bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "edgecolor": "none", "alpha": 0.8})
+    box = view_box(model, traj.x, proj, None, traj.body_x)
+    ax.set_xlim(*box[0])
+    ax.set_ylim(*box[1])
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel(f"{proj.names[0]} [m]")
+    ax.set_ylabel(f"{proj.names[1]} [m]")
+    ax.legend(handles=legend_handles(model), fontsize=7, **OUTSIDE_RIGHT)
+    ax.set_title(f"Shape at t = {traj.t[i]:.3g} s (grey: t = {traj.t[0]:.3g} s)"
+                 + (", seen from the side" if model.dim == 3 else ""))
 
 
 @dataclass(frozen=True)
@@ -199,13 +250,14 @@ class Panel:
 
 
 PANELS = (
+    Panel("shape", lambda model: model.scene.is_system, draw_shape, time_axis=False),
     Panel("energy", lambda model: True, draw_energy),
     Panel("ledger", lambda model: True, draw_ledger),
     Panel("stretch", lambda model: True, draw_stretch),
     Panel("end tensions", lambda model: True, draw_end_tensions, needs_tension=True),
     Panel("tension profile", lambda model: True, draw_tension_profile, time_axis=False, needs_tension=True),
     Panel("towed", lambda model: towed_end(model.scene) is not None, draw_towed, time_axis=False),
-    Panel("shooter", lambda model: model.scene.thrower is not None and model.scene.rope.closed, draw_inclination),
+    Panel("shooter", lambda model: model.scene.thrower is not None and model.lines[0].closed, draw_inclination),
 )
 
 
@@ -227,7 +279,8 @@ def windowed(traj: Trajectory, start: float | None, stop: float | None) -> Traje
     if start is None and stop is None:
         return traj
     sl = frame_window(traj.t, start, stop)
-    cut = {name: getattr(traj, name)[sl] for name in ("t", "x", "v", "tension", "strain", "support", "ledger")
+    cut = {name: getattr(traj, name)[sl] for name in ("t", "x", "v", "tension", "strain", "support", "ledger",
+                                                      "body_x", "body_v", "body_q", "body_w")
            if getattr(traj, name) is not None}
     return replace(traj, **cut)
 
