@@ -23,6 +23,7 @@ per axis of rotation, as the scene's angles do: 3 in 3-D (about x, y, z), 1 in 2
 from __future__ import annotations
 
 from collections import namedtuple
+from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
@@ -320,3 +321,38 @@ def body_results(traj, id: str) -> BodyResults:
     if id not in ids:
         raise _unknown("body", id, ids)
     return BodyResults(traj, ids.index(id))
+
+
+# ------------------------------------------------------------------------------------------ drawing
+
+
+@dataclass(frozen=True)
+class Glyph:
+    """How a rigid body is drawn (the scene gives it no shape): spokes from its reference point to the points
+    on it, ``points`` (K, D) [m] in its frame, and its axes from the reference point, each ``axis_length`` [m]
+    long: half its farthest point's distance, or a tenth of its system's mean line length without points."""
+
+    points: np.ndarray
+    axis_length: float
+
+    def segments(self, position, rotation) -> tuple[np.ndarray, np.ndarray]:
+        """The glyph at ``position`` (D,) [m] turned by ``rotation`` (D, D): its spokes (K, 2, D) and its axes
+        (D, 2, D) as (from, to) pairs [m], axis k along the rotation's column k."""
+        position, rotation = np.asarray(position, dtype=float), np.asarray(rotation, dtype=float)
+        tips = position + self.points @ rotation.T
+        spokes = np.stack([np.broadcast_to(position, tips.shape), tips], axis=1)
+        ends = position + self.axis_length * rotation.T
+        axes = np.stack([np.broadcast_to(position, ends.shape), ends], axis=1)
+        return spokes, axes
+
+
+def body_glyphs(scene) -> list[Glyph]:
+    """Each rigid body's :class:`Glyph`, in the scene's order."""
+    mean_length = float(np.mean([line.length for line in scene.lines])) if scene.lines else 1.0
+    out = []
+    for body in scene.rigid_bodies:
+        local = np.array([p.position for p in scene.points if p.kind == "body" and p.body == body.id],
+                         dtype=float).reshape(-1, scene.dimension)
+        reach = float(np.linalg.norm(local, axis=1).max()) if len(local) else 0.0
+        out.append(Glyph(local, 0.5 * reach if reach > 0 else 0.1 * mean_length))
+    return out

@@ -25,6 +25,7 @@ from .output import output_path
 from .scene_artist import Geometry, RopeArtist, body_state, legend_handles, style_axes
 from .style import with_picture_text
 from .timeline import animation_plan
+from .view3d import wants_3d
 
 DPI = 100
 PALETTE_SAMPLES = 5  # frames, evenly spread, whose colours make a GIF's palette
@@ -90,11 +91,53 @@ class FrameRenderer:
         return np.array(self.canvas.buffer_rgba())  # a plain copy: RGBA -> RGB is left to the encoder (in C)
 
 
-def picture_title(fig, model: Model, proj: Projection) -> None:
-    """The scene's name (and the view of a 3-D scene) at the top left, the legend on a line below it."""
+class FrameRenderer3D:
+    """Renders saved frame i of a 3-D run in the 3-D view (:mod:`ropesim.render.view3d`) to an RGBA array
+    (H, W, 4) uint8; the whole picture is drawn for every frame."""
+
+    def __init__(self, traj: Frames, model: Model, nodes: np.ndarray | None, size: int):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        from .framing import MACRO_BLOCK
+        from .view3d import Geometry3D, State3D, axes_3d, azimuth, run_box
+
+        self.traj, self.nodes = traj, nodes
+        width = MACRO_BLOCK * round(size / MACRO_BLOCK)
+        height = MACRO_BLOCK * round(0.8 * size / MACRO_BLOCK)
+        self.size = (width, height)
+        fig = Figure(figsize=figure_inches(width, height, DPI), dpi=DPI)
+        self.canvas = FigureCanvasAgg(fig)
+        top = (22 + (16 if legend_handles(model) else 0)) / height
+        box = run_box(traj.x, nodes, getattr(traj, "body_x", None))
+        self.ax = axes_3d(fig, [0.02, 0.02, 0.96, 0.96 - top], box, nodes is not None,
+                          azim=azimuth(model, np.asarray(traj.x[0])))
+        picture_title(fig, model, VIEW_3D)
+        self.geometry = Geometry3D(self.ax, model, box)
+        self.state = State3D(self.ax, model)
+        self.stamp = fig.text(1 - 6 / width, 1 - 3 / height, "", ha="right", va="top", fontsize=9)
+
+    def render(self, i: int) -> np.ndarray:
+        x = np.asarray(self.traj.x[i])
+        shift = None
+        if self.nodes is not None:
+            shift = origin(x, self.nodes)
+            self.geometry.move(shift)
+        self.state.show(x, shift, body_state(self.traj, i))
+        self.stamp.set_text(f"t = {self.traj.t[i]:.2f} s")
+        self.canvas.draw()
+        return np.array(self.canvas.buffer_rgba())
+
+
+VIEW_3D = None   # picture_title's projection for the 3-D view
+
+
+def picture_title(fig, model: Model, proj: Projection | None) -> None:
+    """The scene's name (and the view of a 3-D scene: a projection, or None for the 3-D view) at the top left,
+    the legend on a line below it."""
     parts = [model.scene.name]
     if model.scene.dimension == 3:
-        parts.append(f"view {''.join(proj.names)}")
+        parts.append(f"view {''.join(proj.names)}" if proj is not None else "view 3d")
     height = fig.bbox.height
     fig.text(4 / fig.bbox.width, 1 - 3 / height, "  ·  ".join(parts), ha="left", va="top", fontsize=9,
              fontweight="bold")
@@ -112,7 +155,8 @@ def animate(traj: Frames, out: str | Path, *, fps: float = 25.0, speed: float = 
     """Write an animation of ``traj`` to ``out`` (.gif or .mp4) and say what was written.
 
     fps: video frames per second; speed: simulated seconds per second of video; start/end: the time range
-    [s] (default the whole run); follow: the view from the driven node; view: the projection of a 3-D scene;
+    [s] (default the whole run); follow: the view from the driven node; view: the projection of a 3-D scene
+    ("xy", "xz", "zy", ...) or "3d" (:mod:`ropesim.render.view3d`; the default for a 3-D system);
     size: the picture's longer side [px]; note: receives one-line remarks (too few saved frames, GIF rate).
     Raises :class:`ropesim.render.RenderError` for a request that cannot be met, before writing anything.
     """
@@ -127,8 +171,12 @@ def animate(traj: Frames, out: str | Path, *, fps: float = 25.0, speed: float = 
         if fps > GIF_MAX_FPS:
             remarks.append(f"a GIF plays at most {GIF_MAX_FPS:g} fps: using {rate:g} (write an .mp4 for more)")
     plan = animation_plan(traj.t, rate, speed, start, end)
-    model = build(traj.scene)
-    proj = projection(view, traj.scene.dimension)
+    model = build(traj.scene, solve=False)   # the frames hold the shape: no static solve
+    three_d = wants_3d(view, traj.scene)
+    proj = None if three_d else projection(view, traj.scene.dimension)
+    if three_d and traj.scene.dimension != 3:
+        raise RenderError(f"--view {view}: the 3-D view is for 3-D scenes; this one is {traj.scene.dimension}-D "
+                          f"(its view is xy)")
     nodes = followed_nodes(model, follow)
     if plan.note:
         remarks.append(plan.note)
@@ -136,7 +184,8 @@ def animate(traj: Frames, out: str | Path, *, fps: float = 25.0, speed: float = 
         if note is not None:
             note(remark)
     check_memory(size * size, f"--size {size}")     # the picture is at most size x size px
-    renderer = FrameRenderer(traj, model, proj, nodes, size)
+    renderer = (FrameRenderer3D(traj, model, nodes, size) if three_d else
+                FrameRenderer(traj, model, proj, nodes, size))
     frames = _tracked((renderer.render(i) for i in plan.indices), len(plan.indices), f"encoding {out.name}",
                       progress)
     with atomic_output(real) as tmp:

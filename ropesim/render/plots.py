@@ -216,8 +216,11 @@ def draw_shape(ax, traj: Trajectory, model: Model) -> None:
     from .framing import projection, view_box
     from .scene_artist import Geometry, RopeArtist, body_state
 
-    proj = projection(None, model.dim)
     i = last_finite_frame(traj)
+    if ax.name == "3d":
+        _draw_shape_3d(ax, traj, model, i)
+        return
+    proj = projection(None, model.dim)
     Geometry(ax, model, proj)
     RopeArtist(ax, model, proj, color="0.82").show(np.asarray(traj.x[0]), None, body_state(traj, 0))
     shown = RopeArtist(ax, model, proj)
@@ -238,6 +241,33 @@ def draw_shape(ax, traj: Trajectory, model: Model) -> None:
                  + (", seen from the side" if model.dim == 3 else ""))
 
 
+def _draw_shape_3d(ax, traj: Trajectory, model: Model, i: int) -> None:
+    """:func:`draw_shape` in the 3-D view (:func:`shape_axes` made ``ax``)."""
+    from .scene_artist import body_state
+    from .view3d import Geometry3D, State3D, plotted
+
+    Geometry3D(ax, model, ax.scene_box)
+    State3D(ax, model, color="0.82").show(np.asarray(traj.x[0]), None, body_state(traj, 0))
+    x = np.asarray(traj.x[i])
+    State3D(ax, model).show(x, None, body_state(traj, i))
+    for line in model.lines:
+        ax.text(*plotted(x[line.first + line.nodes // 2]), f" {line.id}", fontsize=7, zorder=7)
+    ax.legend(handles=legend_handles(model), fontsize=7, **OUTSIDE_RIGHT)
+    ax.set_title(f"Shape at t = {traj.t[i]:.3g} s (grey: t = {traj.t[0]:.3g} s)")
+
+
+def shape_axes(fig, spec, traj: Trajectory, model: Model):
+    """The shape panel's axes: a 3-D view for a 3-D scene (:mod:`ropesim.render.view3d`), else a plain one."""
+    if model.dim != 3:
+        return fig.add_subplot(spec)
+    from .view3d import axes_3d, azimuth, run_box
+
+    box = run_box(traj.x, None, traj.body_x)
+    ax = axes_3d(fig, spec, box, False, azim=azimuth(model, np.asarray(traj.x[0])))
+    ax.scene_box = box
+    return ax
+
+
 @dataclass(frozen=True)
 class Panel:
     """One figure of the plot: its name, which scenes it is for, and how it is drawn."""
@@ -247,10 +277,13 @@ class Panel:
     draw: Callable  # (ax, traj, model) -> None
     time_axis: bool = True
     needs_tension: bool = False   # only for run folders that store tension (ropesim 0.2 on)
+    axes: Callable | None = None  # (fig, subplot spec, traj, model) -> its axes; None: a plain one
+    rows: Callable[[Model], int] = lambda model: 1   # its height, in panels
 
 
 PANELS = (
-    Panel("shape", lambda model: model.scene.is_system, draw_shape, time_axis=False),
+    Panel("shape", lambda model: model.scene.is_system, draw_shape, time_axis=False, axes=shape_axes,
+          rows=lambda model: 2 if model.dim == 3 else 1),
     Panel("energy", lambda model: True, draw_energy),
     Panel("ledger", lambda model: True, draw_ledger),
     Panel("stretch", lambda model: True, draw_stretch),
@@ -295,12 +328,14 @@ def run_figure(traj: Trajectory, start: float | None = None, stop: float | None 
         traj = windowed(traj, start, stop)
     except ValueError as exc:
         raise RenderError(str(exc)) from None
-    model = build(traj.scene)
+    model = build(traj.scene, solve=False)   # the frames hold the shape: no static solve
     panels = [p for p in PANELS if p.applies(model) and (traj.tension is not None or not p.needs_tension)]
-    height = HEADER + PANEL_HEIGHT * len(panels)
+    rows = [panel.rows(model) for panel in panels]
+    height = HEADER + PANEL_HEIGHT * sum(rows)
     fig = Figure(figsize=figure_inches(WIDTH, height, DPI), dpi=DPI, layout="constrained")
-    axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
-    for ax, panel in zip(axes, panels):
+    grid = fig.add_gridspec(len(panels), 1, height_ratios=rows)
+    for k, panel in enumerate(panels):
+        ax = (panel.axes or (lambda fig, spec, traj, model: fig.add_subplot(spec)))(fig, grid[k, 0], traj, model)
         panel.draw(ax, traj, model)
         if panel.time_axis:
             ax.set_xlabel("t [s]")

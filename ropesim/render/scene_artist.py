@@ -154,49 +154,36 @@ class RopeArtist:
 
 
 class BodyGlyphs:
-    """A system's rigid bodies, each drawn as spokes from its reference point to the points on it (dark grey,
-    the reference point a ring) and its three axes from the reference point (x red, y green, z blue; a 2-D
-    body's x and y), each as long as half its farthest point's distance (a tenth of its lines' mean length
-    for a body without points)."""
+    """A system's rigid bodies, each drawn as its :class:`ropesim.analysis.objects.Glyph`: spokes from its
+    reference point to the points on it (dark grey, the reference point a ring) and its axes (x red, y green,
+    z blue; a 2-D body's x and y)."""
 
     def __init__(self, model: Model, proj: Projection, alpha: float = 1.0):
+        from ..analysis.objects import body_glyphs
         from ..analysis.rotation import rotation_matrix
 
         self.rotation_matrix = rotation_matrix
-        scene = model.scene
-        self.cols, self.dim = list(proj.axes), scene.dimension
-        self.offsets = []     # per body: its points' positions in its frame (K, D)
-        self.lengths = []     # per body: its axes' drawn length [m]
-        mean_length = float(np.mean([line.segments * line.segment_length for line in model.lines]))
-        for body in scene.rigid_bodies:
-            local = np.array([p.position for p in scene.points if p.kind == "body" and p.body == body.id],
-                             dtype=float).reshape(-1, self.dim)
-            self.offsets.append(local)
-            reach = float(np.linalg.norm(local, axis=1).max()) if len(local) else 0.0
-            self.lengths.append(0.5 * reach if reach > 0 else 0.1 * mean_length)
-        count = len(scene.rigid_bodies)
+        self.glyphs = body_glyphs(model.scene)
+        self.cols, self.dim = list(proj.axes), model.scene.dimension
         self.spokes = Line2D([], [], color=BODY_COLOR, linewidth=2.6, alpha=alpha, zorder=4, solid_capstyle="round")
         self.centres = Line2D([], [], linestyle="none", marker="o", markersize=5.0, markerfacecolor="white",
                               markeredgecolor=BODY_COLOR, markeredgewidth=1.4, alpha=alpha, zorder=6)
         self.axes = [Line2D([], [], color=c, linewidth=1.4, alpha=alpha, zorder=5) for c in AXIS_COLORS[:self.dim]]
-        self.artists = [self.spokes, *self.axes, self.centres] if count else []
+        self.artists = [self.spokes, *self.axes, self.centres]
 
     def shapes(self, state) -> tuple[np.ndarray, list[np.ndarray], np.ndarray]:
         """The glyphs of body state ``state`` ((B, D) positions, (B, 4) quaternions) in scene coordinates: the
-        spokes (each from the reference point to a point, NaN between), each axis's segments (NaN between),
-        the reference points (B, D)."""
+        spokes as one polyline (NaN between spokes), each axis's segments (NaN between bodies), the reference
+        points (B, D)."""
         position, quaternion = (np.asarray(a, dtype=float) for a in state)
         rotation = self.rotation_matrix(quaternion, self.dim)
-        gap = np.full((1, self.dim), np.nan)
         spokes, axes = [], [[] for _ in range(self.dim)]
-        for b, (local, length) in enumerate(zip(self.offsets, self.lengths)):
-            origin = position[b]
-            for point in local:
-                spokes += [origin, origin + rotation[b] @ point, gap[0]]
+        for glyph, where, turn in zip(self.glyphs, position, rotation):
+            body_spokes, body_axes = glyph.segments(where, turn)
+            spokes += [broken_polyline(body_spokes)]
             for k in range(self.dim):
-                axes[k] += [origin, origin + length * rotation[b][:, k], gap[0]]
-        spokes = np.array(spokes).reshape(-1, self.dim)
-        return spokes, [np.array(a).reshape(-1, self.dim) for a in axes], position
+                axes[k].append(broken_polyline(body_axes[k:k + 1]))
+        return (np.concatenate(spokes), [np.concatenate(a) for a in axes], position)
 
     def show(self, state) -> None:
         """Draw the bodies at ``state`` ((B, D), (B, 4)); None hides them (a run without body states)."""
@@ -210,6 +197,12 @@ class BodyGlyphs:
         for artist, segments in zip(self.axes, axes):
             artist.set_data(segments[:, u], segments[:, v])
         self.centres.set_data(centres[:, u], centres[:, v])
+
+
+def broken_polyline(pairs: np.ndarray) -> np.ndarray:
+    """(from, to) pairs (K, 2, D) as one polyline that matplotlib breaks at the NaN rows between them."""
+    gap = np.full((len(pairs), 1, pairs.shape[-1]), np.nan)
+    return np.concatenate([pairs, gap], axis=1).reshape(-1, pairs.shape[-1])
 
 
 def body_state(traj, i: int):
