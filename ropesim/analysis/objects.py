@@ -40,6 +40,20 @@ def line_ids(scene) -> tuple[str, ...]:
     return tuple(line.id for line in line_layouts(scene))
 
 
+def made_of(scene) -> str:
+    """What a scene's nodes make, in a phrase: "open line", "closed loop", or a system's "2 lines, 3 points"
+    (and its rigid bodies)."""
+    if not scene.is_system:
+        return "closed loop" if scene.rope.closed else "open line"
+
+    def count(n: int, one: str, many: str) -> str:
+        return f"{n} {one if n == 1 else many}"
+    parts = [count(len(scene.lines), "line", "lines"), count(len(scene.points), "point", "points")]
+    if scene.rigid_bodies:
+        parts.append(count(len(scene.rigid_bodies), "rigid body", "rigid bodies"))
+    return ", ".join(parts)
+
+
 def _unknown(what: str, key: str, known) -> KeyError:
     known = list(known)
     listed = ", ".join(repr(k) for k in known) if known else "none"

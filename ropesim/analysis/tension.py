@@ -115,6 +115,20 @@ def _line_window(tension, t: np.ndarray, frames: slice) -> dict:
             "max_t_s": float(f"{float(t[k]):.12g}")}
 
 
+def end_columns(model) -> list[tuple[str, int]]:
+    """(label, column in the frames' tension array) of every line end: a rope's "segment 0 (at node 0)" and its
+    last segment's; a system's "LINE start (POINT)" and "LINE end (POINT)"."""
+    from ..model.tension import line_segments
+
+    if not model.scene.is_system:
+        last = sum(line.segments for line in model.lines) - 1
+        return [("segment 0 (at node 0)", 0)] + ([(f"segment {last} (the other end)", last)] if last > 0 else [])
+    out = []
+    for line, part in zip(model.scene.lines, line_segments(model)):
+        out += [(f"{line.id} start ({line.start})", part.start), (f"{line.id} end ({line.end})", part.stop - 1)]
+    return out
+
+
 def support_labels(scene) -> list[str]:
     """A system's supports (its held nodes, in node order) by the point that holds them and the line end there:
     "anchor1 (line1's start)"."""

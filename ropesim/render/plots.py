@@ -149,25 +149,11 @@ def draw_inclination(ax, traj: Trajectory, model: Model) -> None:
     ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
 
-def end_labels(model: Model) -> list[tuple[str, int]]:
-    """(label, column in the frames' tension array) of every line end: a rope's "segment 0 (at node 0)" and
-    its last segment's; a system's "LINE start (POINT)" and "LINE end (POINT)"."""
-    from ..model.tension import line_segments
-
-    if not model.scene.is_system:
-        last = sum(line.segments for line in model.lines) - 1
-        return [("segment 0 (at node 0)", 0)] + ([(f"segment {last} (the other end)", last)] if last > 0 else [])
-    out = []
-    for line, part in zip(model.scene.lines, line_segments(model)):
-        out += [(f"{line.id} start ({line.start})", part.start), (f"{line.id} end ({line.end})", part.stop - 1)]
-    return out
-
-
 def draw_end_tensions(ax, traj: Trajectory, model: Model) -> None:
     """The tension in the first and last segment of every line (a rope's two ends) over time."""
-    from ..analysis.tension import force_unit
+    from ..analysis.tension import end_columns, force_unit
 
-    labels = end_labels(model)
+    labels = end_columns(model)
     ends = np.asarray(traj.tension[:, [column for _, column in labels]])
     unit, scale = force_unit(float(np.nanmax(np.abs(ends), initial=0.0)))
     system = model.scene.is_system
