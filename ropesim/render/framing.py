@@ -39,7 +39,7 @@ def projection(view: str | None, dim: int) -> Projection:
     view = "xy" if view is None else view.strip().lower()
     allowed = AXIS_NAMES[:dim]
     if len(view) != 2 or view[0] == view[1] or any(c not in allowed for c in view):
-        example = "xy (side view), xz (from above) or zy (from the front)" if dim == 3 else "xy"
+        example = "xy (side view), xz (from above) or zy (from the front), or 3d for a 3-D view" if dim == 3 else "xy"
         raise RenderError(f"--view {view}: choose two different axes of this {dim}-D scene from "
                           f"{', '.join(allowed)}, e.g. {example}")
     return Projection((allowed.index(view[0]), allowed.index(view[1])))
