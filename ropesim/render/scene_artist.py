@@ -123,7 +123,7 @@ class RopeArtist:
         for k, line in enumerate(model.lines):
             shade = color or (line_color(k) if model.scene.is_system else ROPE_COLOR)
             artist = Line2D([], [], color=shade, linewidth=1.4, marker=marker, markersize=NODE_SIZE, alpha=alpha,
-                            zorder=3, label=line.id)
+                            zorder=3, label=line.id if color is None else f"_{line.id}")   # a shade: unnamed
             self.lines.append((slice(line.first, line.end), line.closed, artist))
         self.line = self.lines[0][2]
         self.special = [(idx, Line2D([], [], linestyle="none", alpha=alpha, **style))

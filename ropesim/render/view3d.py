@@ -162,7 +162,7 @@ class State3D:
         for k, line in enumerate(model.lines):
             shade = color or (line_color(k) if model.scene.is_system else ROPE_COLOR)
             (artist,) = ax.plot([], [], [], color=shade, linewidth=1.8, marker=marker, markersize=NODE_SIZE,
-                                alpha=alpha, label=line.id, zorder=3)
+                                alpha=alpha, label=line.id if color is None else f"_{line.id}", zorder=3)
             self.lines.append((slice(line.first, line.end), line.closed, artist))
         self.special = [(idx, ax.plot([], [], [], linestyle="none", alpha=alpha, **style)[0])
                         for _, idx, style in special_nodes(model)]
