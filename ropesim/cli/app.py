@@ -959,6 +959,11 @@ def export(
     STEM_tension_range.csv (per segment: min, max, mean and std of its tension), in kN where forces reach
     kilonewtons; --from/--until keep a window (leave the ramp-in out).
 
+    A system of lines: in VTK each line is a block of its own, named by its id, and rigid bodies are glyphs (their
+    axes and spokes to their points, with the force and moment of their lines); in CSV each row names its line,
+    the force tables go by line end and support point, and STEM_bodies.csv holds each body's pose, velocities,
+    force and moment per frame.
+
     NetCDF is not offered: xarray with h5py would add about 120 MB to hold the three arrays trajectory.npz
     already holds (numpy.load reads it; xarray wraps it in one call).
     """
