@@ -323,3 +323,20 @@ def test_a_sweep_tabulates_each_lines_tensions(tmp_path):
     rows = read_table(tmp_path / "sweep" / "results.csv")
     light, heavy = sorted(rows, key=lambda r: float(r["points.2.mass"]))
     assert float(heavy["lines.left_wire.max_N"]) > float(light["lines.left_wire.max_N"]) > 0
+
+
+def test_plot_follows_each_body_and_draws_the_3d_shape(spar):
+    from ropesim.render.plots import run_figure
+    from ropesim.render.view3d import plotted
+
+    fig, panels = run_figure(spar)
+    assert panels[-2:] == ("body motion", "body rotation")
+    assert fig.axes[0].name == "3d"                     # a 3-D system's shape panel
+    shown = [a for a in fig.axes[0].lines if a.get_label() == "line2"]
+    x = np.asarray(spar.x[-1])[21:42]
+    assert len(shown) == 1 and np.allclose(np.array(shown[0].get_data_3d()).T, np.stack(plotted(x), -1))
+    body = spar.body("spar")
+    motion = {a.get_label(): a.get_ydata() for a in fig.axes[panels.index("body motion")].lines}
+    assert np.allclose(motion["spar: Δz"], body.position[:, 2] - body.position[0, 2])
+    turns = {a.get_label(): a.get_ydata() for a in fig.axes[panels.index("body rotation")].lines}
+    assert np.allclose(turns["spar: about y"], body.angles[:, 1])

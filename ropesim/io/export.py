@@ -212,14 +212,13 @@ def _history(traj, path: Path, window: slice) -> None:
     """A row per frame: t [s], the tension at both ends (of every line) and each support's force components, in
     N or kN."""
     from ..analysis.tension import force_unit, support_labels
-    from ..model.tension import line_segments
 
     dim = traj.x.shape[2]
     held = _held_nodes(traj) if traj.support is not None else np.zeros(0, dtype=int)
     system = traj.scene.is_system
     if system:
-        parts = line_segments(_Lines(_layouts(traj)))
-        ends = np.asarray(traj.tension[window][:, [k for part in parts for k in (part.start, part.stop - 1)]])
+        first = np.cumsum([0] + [line.segments for line in _layouts(traj)])
+        ends = np.asarray(traj.tension[window][:, [k for a, b in zip(first[:-1], first[1:]) for k in (a, b - 1)]])
     else:
         ends = np.asarray(traj.tension[window][:, [0, -1]])
     supports = np.asarray(traj.support[window]).reshape(len(ends), -1) if held.size else np.zeros((len(ends), 0))
@@ -303,13 +302,6 @@ def _layouts(traj):
     from ..model.layout import line_layouts
 
     return line_layouts(traj.scene)
-
-
-class _Lines:
-    """What :func:`ropesim.model.tension.line_segments` reads of a model: its lines."""
-
-    def __init__(self, lines):
-        self.lines = lines
 
 
 def _vtk(traj, out: Path, meshio, window: slice) -> tuple[Path, list[Path]]:

@@ -1,8 +1,12 @@
 """`ropesim plot`: the figures a user wants from a run, one panel each, stacked in one PNG.
 
-Every run: the mechanical energy term by term [J], and the largest relative spring stretch |r| / l - 1 [%],
-over time. A towed rope (the helicopter scenes): the angle from vertical of every segment along the rope at
-the last frame, against the exact discrete steady state. A string shooter: the loop's inclination over time.
+Every run: the mechanical energy term by term [J], the energy ledger, and the largest relative spring stretch
+|r| / l - 1 [%], over time; the tension at the rope's ends over time, and along the rope. A system of lines:
+its shape at the last frame (every line drawn and labelled, over its start), the tension at every line end over
+time and along each line, and its rigid bodies' motions (their reference points from where they start, and
+their angles) over time. A towed rope (the helicopter scenes): the angle from vertical of every segment along
+the rope at the last frame, against the exact discrete steady state. A string shooter: the loop's inclination
+over time.
 Per-frame series are computed in blocks of frames, so a memory-mapped run of any length can be plotted.
 ``start``/``stop`` (``--from``/``--to``) plot a window of the run, its ranges and extremes over that window;
 forces are in kN where they reach kilonewtons.
@@ -254,6 +258,41 @@ def shape_axes(fig, spec, traj: Trajectory, model: Model):
     return ax
 
 
+BODY_STYLES = ("-", "--", ":", "-.")   # a system's rigid bodies, in turn
+
+
+def draw_body_motion(ax, traj: Trajectory, model: Model) -> None:
+    """Each rigid body's reference point over time, from where it starts (x red, y green, z blue)."""
+    from .scene_artist import AXIS_COLORS
+
+    for b, body in enumerate(model.scene.rigid_bodies):
+        position = np.asarray(traj.body(body.id).position)
+        for k in range(model.dim):
+            ax.plot(traj.t, position[:, k] - position[0, k], color=AXIS_COLORS[k], linewidth=1.1,
+                    linestyle=BODY_STYLES[b % len(BODY_STYLES)], label=f"{body.id}: Δ{'xyz'[k]}")
+    ax.axhline(0, color="0.6", linewidth=0.8)
+    ax.set_ylabel("displacement [m]")
+    ax.set_title("Rigid bodies: their reference points from where they start")
+    ax.legend(fontsize=7, **OUTSIDE_RIGHT)
+
+
+def draw_body_rotation(ax, traj: Trajectory, model: Model) -> None:
+    """Each rigid body's orientation over time, as the scene's angles (about x, then y, then z)."""
+    from .scene_artist import AXIS_COLORS
+
+    axes = "xyz" if model.dim == 3 else "z"
+    for b, body in enumerate(model.scene.rigid_bodies):
+        angles = traj.body(body.id).angles
+        for k, name in enumerate(axes):
+            ax.plot(traj.t, angles[:, k], color=AXIS_COLORS["xyz".index(name)], linewidth=1.1,
+                    linestyle=BODY_STYLES[b % len(BODY_STYLES)], label=f"{body.id}: about {name}")
+    ax.axhline(0, color="0.6", linewidth=0.8)
+    ax.set_ylabel("angle [deg]")
+    ax.set_title("Rigid bodies: orientation, as the scene's angles (about x, then y, then z)"
+                 if model.dim == 3 else "Rigid bodies: orientation, the angle about z")
+    ax.legend(fontsize=7, **OUTSIDE_RIGHT)
+
+
 @dataclass(frozen=True)
 class Panel:
     """One figure of the plot: its name, which scenes it is for, and how it is drawn."""
@@ -263,6 +302,7 @@ class Panel:
     draw: Callable  # (ax, traj, model) -> None
     time_axis: bool = True
     needs_tension: bool = False   # only for run folders that store tension (ropesim 0.2 on)
+    needs_bodies: bool = False    # only for runs that store rigid bodies' states
     axes: Callable | None = None  # (fig, subplot spec, traj, model) -> its axes; None: a plain one
     rows: Callable[[Model], int] = lambda model: 1   # its height, in panels
 
@@ -275,6 +315,8 @@ PANELS = (
     Panel("stretch", lambda model: True, draw_stretch),
     Panel("end tensions", lambda model: True, draw_end_tensions, needs_tension=True),
     Panel("tension profile", lambda model: True, draw_tension_profile, time_axis=False, needs_tension=True),
+    Panel("body motion", lambda model: bool(model.scene.rigid_bodies), draw_body_motion, needs_bodies=True),
+    Panel("body rotation", lambda model: bool(model.scene.rigid_bodies), draw_body_rotation, needs_bodies=True),
     Panel("towed", lambda model: towed_end(model.scene) is not None, draw_towed, time_axis=False),
     Panel("shooter", lambda model: model.scene.thrower is not None and model.lines[0].closed, draw_inclination),
 )
@@ -315,7 +357,8 @@ def run_figure(traj: Trajectory, start: float | None = None, stop: float | None 
     except ValueError as exc:
         raise RenderError(str(exc)) from None
     model = build(traj.scene, solve=False)   # the frames hold the shape: no static solve
-    panels = [p for p in PANELS if p.applies(model) and (traj.tension is not None or not p.needs_tension)]
+    panels = [p for p in PANELS if p.applies(model) and (traj.tension is not None or not p.needs_tension)
+              and (traj.body_x is not None or not p.needs_bodies)]
     rows = [panel.rows(model) for panel in panels]
     height = HEADER + PANEL_HEIGHT * sum(rows)
     fig = Figure(figsize=figure_inches(WIDTH, height, DPI), dpi=DPI, layout="constrained")
