@@ -165,7 +165,8 @@ class LineResults:
         return self.first if which == "start" else self.first + self.nodes - 1
 
 
-def _lines(traj) -> dict[str, LineResults]:
+def every_line(traj) -> dict[str, LineResults]:
+    """Every line's :class:`LineResults` by id, in the scene's order."""
     scene = traj.scene
     layouts = line_layouts(scene)
     ends = [(line.start, line.end) for line in scene.lines] if scene.is_system else [(None, None)]
@@ -175,7 +176,7 @@ def _lines(traj) -> dict[str, LineResults]:
 
 def line_results(traj, id: str) -> LineResults:
     """Line ``id``'s :class:`LineResults`; KeyError (naming the run's lines) for an unknown id."""
-    lines = _lines(traj)
+    lines = every_line(traj)
     if id not in lines:
         raise _unknown("line", id, lines)
     return lines[id]
@@ -238,7 +239,7 @@ def point_results(traj, id: str) -> PointResults:
     points = {p.id: p for p in traj.scene.points}
     if id not in points:
         raise _unknown("point", id, points)
-    return PointResults(traj, points[id], _lines(traj))
+    return PointResults(traj, points[id], every_line(traj))
 
 
 class BodyResults:
@@ -298,7 +299,7 @@ class BodyResults:
 
     @cached_property
     def _wrench(self) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
-        lines = _lines(self.traj)
+        lines = every_line(self.traj)
         forces: dict[str, np.ndarray] = {}
         moments: dict[str, np.ndarray] = {}
         x_b = np.asarray(self.position, dtype=float)

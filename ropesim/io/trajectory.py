@@ -185,8 +185,8 @@ class Trajectory:
     @property
     def lines(self) -> dict:
         """Every line's results by id, in the scene's order (a rope: {"rope": ...}); see :meth:`line`."""
-        from ..analysis.objects import line_results, line_ids
-        return {key: line_results(self, key) for key in line_ids(self.scene)}
+        from ..analysis.objects import every_line
+        return every_line(self)
 
     @property
     def points(self) -> dict:
