@@ -340,3 +340,17 @@ def test_plot_follows_each_body_and_draws_the_3d_shape(spar):
     assert np.allclose(motion["spar: Δz"], body.position[:, 2] - body.position[0, 2])
     turns = {a.get_label(): a.get_ydata() for a in fig.axes[panels.index("body rotation")].lines}
     assert np.allclose(turns["spar: about y"], body.angles[:, 1])
+
+
+def test_a_3d_animation_frame_equals_the_whole_picture_drawn_afresh(spar):
+    """The 3-D animation draws only what moves over the view it drew once; a frame so made is the picture a
+    full drawing makes, pixel for pixel (the fixed points' markers over the lines, as a full drawing has them)."""
+    from ropesim.render.animate import FrameRenderer3D
+
+    renderer = FrameRenderer3D(spar, build(spar.scene, solve=False), None, 480)
+    fast = [renderer.render(k) for k in (3, 8)]
+    for artist in renderer.moving:
+        artist.set_animated(False)
+    renderer.canvas.draw()
+    assert np.array_equal(fast[1], np.array(renderer.canvas.buffer_rgba()))
+    assert not np.array_equal(fast[0], fast[1])

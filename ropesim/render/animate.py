@@ -93,7 +93,8 @@ class FrameRenderer:
 
 class FrameRenderer3D:
     """Renders saved frame i of a 3-D run in the 3-D view (:mod:`ropesim.render.view3d`) to an RGBA array
-    (H, W, 4) uint8; the whole picture is drawn for every frame."""
+    (H, W, 4) uint8, redrawing only what moves: the view is fixed, so the axes keep the projection of their one
+    full drawing (in a view that follows the driven node the fixed parts move too, and are redrawn)."""
 
     def __init__(self, traj: Frames, model: Model, nodes: np.ndarray | None, size: int):
         from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -116,6 +117,14 @@ class FrameRenderer3D:
         self.geometry = Geometry3D(self.ax, model, box)
         self.state = State3D(self.ax, model)
         self.stamp = fig.text(1 - 6 / width, 1 - 3 / height, "", ha="right", va="top", fontsize=9)
+        fixed = self.geometry.artists if nodes is not None else [a for a in self.geometry.artists
+                                                                  if a is self.geometry.pinned]
+        # in zorder, as a full drawing would: the fixed points' markers over the lines that end on them
+        self.moving = sorted(fixed + self.state.artists, key=lambda a: a.get_zorder()) + [self.stamp]
+        for artist in self.moving:
+            artist.set_animated(True)
+        self.canvas.draw()     # the axes, their projection and the fixed parts, once
+        self.background = self.canvas.copy_from_bbox(fig.bbox)
 
     def render(self, i: int) -> np.ndarray:
         x = np.asarray(self.traj.x[i])
@@ -125,7 +134,10 @@ class FrameRenderer3D:
             self.geometry.move(shift)
         self.state.show(x, shift, body_state(self.traj, i))
         self.stamp.set_text(f"t = {self.traj.t[i]:.2f} s")
-        self.canvas.draw()
+        self.canvas.restore_region(self.background)
+        renderer = self.canvas.get_renderer()
+        for artist in self.moving:
+            artist.draw(renderer)
         return np.array(self.canvas.buffer_rgba())
 
 

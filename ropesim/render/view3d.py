@@ -8,8 +8,9 @@ read alike everywhere in the picture, with equal scales on the three axes.
 
 The scene's y points up, so it is drawn on matplotlib's vertical axis: a scene point (x, y, z) is plotted at
 (x, -z, y), a proper rotation (the picture is not mirrored), and the axis across the back is labelled z with
-its ticks showing z. The seabed is a translucent plane under the run's extent. A 3-D axes cannot keep a saved
-background (its projection changes what every artist covers), so each frame of an animation is drawn whole.
+its ticks showing z. The seabed is a translucent plane under the run's extent. The view does not move during an
+animation, so its axes, panes, grid and fixed parts are drawn once and kept, and each frame draws only what
+moves over them, in the view's projection (as the projections' animations do).
 """
 
 from __future__ import annotations
@@ -176,6 +177,12 @@ class State3D:
             (self.centres,) = ax.plot([], [], [], linestyle="none", marker="o", markersize=5.0,
                                       markerfacecolor="white", markeredgecolor=BODY_COLOR, markeredgewidth=1.4,
                                       alpha=alpha, zorder=6)
+
+    @property
+    def artists(self) -> list:
+        """Everything this state draws, in drawing order."""
+        body = [self.spokes, *self.axes, self.centres] if self.glyphs else []
+        return [artist for _, _, artist in self.lines] + [artist for _, artist in self.special] + body
 
     def show(self, x: np.ndarray, shift: np.ndarray | None = None, bodies=None) -> None:
         """Show positions ``x`` (N, 3) [m] (and ``bodies``: body_x (B, 3), body_q (B, 4)), relative to
