@@ -4,16 +4,12 @@ runs from its start point to its end point with a sag, and its segments carry ma
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 import ropesim
 from ropesim.io.trajectory import Trajectory
 from ropesim.model.layout import line_layouts
-
-ROOT_SYSTEMS = Path(__file__).parent / "data" / "systems"
 
 BODY_2D = """
 name = "plate_2d"
@@ -119,30 +115,3 @@ def turning_body_run(scene, frames: int = 25, axis=(0.3, 0.9, 0.2), rate: float 
 def plate_scene():
     return ropesim.scene_from_toml(BODY_2D)
 
-
-def place_body_points(monkeypatch) -> None:
-    """Until the model has rigid bodies: let ``build`` place a body's points where the body holds them at t = 0
-    (x_b + R p), so that the pictures and exports of a made-up run can lay its scene out. Does nothing once
-    ``build`` places them itself."""
-    from ropesim.model import build as build_module
-
-    scene = ropesim.load_scene(ROOT_SYSTEMS / "oc3_hywind.toml")
-    try:
-        build_module.point_position(scene, scene.points[-1])
-        return
-    except NotImplementedError:
-        pass
-    original = build_module.point_position
-
-    def point_position(scene, point):
-        if point.kind != "body":
-            return original(scene, point)
-        body = next(b for b in scene.rigid_bodies if b.id == point.body)
-        dim = scene.dimension
-        angles = np.asarray(body.orientation, dtype=float)
-        turn = Rotation.from_euler("xyz", angles if dim == 3 else [0.0, 0.0, angles[0]], degrees=True)
-        local = np.zeros(3)
-        local[:dim] = point.position
-        return tuple(np.asarray(body.position, dtype=float) + turn.apply(local)[:dim])
-
-    monkeypatch.setattr(build_module, "point_position", point_position)

@@ -1,8 +1,8 @@
 """Every command on a system of lines, end to end and by content: a run of the clump weight (two wires meeting at
 a free 200 kg point) through `ropesim run`, then check, summary, plot, frames, animate, export, view and sweep;
 what they draw, write and print is compared with the run's own arrays, line by line (each line's nodes as
-the model lays them out). A made-up turning body (tests/synthetic_system.py) stands in for the rigid bodies'
-pictures, exports and views until the model integrates them."""
+the model lays them out). A plate swinging on two legs is a real run with a rigid body; a made-up turning spar
+(tests/synthetic_system.py: its motion known in closed form) checks what is drawn and exported of a 3-D body."""
 
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ from ropesim.model.build import build
 from ropesim.model.layout import line_layouts
 
 from conftest import ROOT
-from synthetic_system import place_body_points, plate_scene, turning_body_run
+from synthetic_system import plate_scene, turning_body_run
 
 SYSTEMS = ROOT / "tests" / "data" / "systems"
 CLUMP = SYSTEMS / "clump_weight.toml"
@@ -49,12 +49,9 @@ def clump(tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="module")
-def spar(tmp_path_factory):
+def spar():
     """A made-up run of OC3-Hywind's spar turning at a steady rate while it drifts (tests/synthetic_system.py)."""
-    patch = pytest.MonkeyPatch()
-    place_body_points(patch)
-    yield turning_body_run(ropesim.load_scene(SYSTEMS / "oc3_hywind.toml"), frames=9)
-    patch.undo()
+    return turning_body_run(ropesim.load_scene(SYSTEMS / "oc3_hywind.toml", ["initial.shape=lines"]), frames=9)
 
 
 # ------------------------------------------------------------------------------------------ check, run, summary
@@ -86,7 +83,9 @@ def test_run_prints_each_lines_tensions_as_the_summary_holds_them(clump):
         assert figures["start_N"] == pytest.approx(float(tension[-1, 0]))
         assert figures["end_N"] == pytest.approx(float(tension[-1, -1]))
         assert figures["max_N"] == pytest.approx(float(np.max(tension)))
-        assert f"tension, {line} {figures['start_N']:.4g} N at its start, {figures['end_N']:.4g} N at its end" in out
+        scale, unit = (1e3, "kN") if max(f["max_N"] for f in summary["lines"].values()) >= 1e3 else (1.0, "N")
+        assert (f"tension, {line} {figures['start_N'] / scale:.4g} {unit} at its start, "
+                f"{figures['end_N'] / scale:.4g} {unit} at its end") in out
 
 
 def test_summary_gives_each_line_end_and_support_over_the_window(clump):
@@ -194,28 +193,23 @@ def test_a_2d_body_is_drawn_as_its_axes_and_spokes(tmp_path):
     from ropesim.render.framing import projection
     from ropesim.render.scene_artist import RopeArtist
 
-    patch = pytest.MonkeyPatch()
-    place_body_points(patch)
-    try:
-        plate = turning_body_run(plate_scene(), frames=7, rate=1.1)
-        model = build(plate.scene, solve=False)
-        artist = RopeArtist(Figure().add_subplot(), model, projection(None, 2))
-        k = 4
-        artist.show(np.asarray(plate.x[k]), None, (np.asarray(plate.body_x[k]), np.asarray(plate.body_q[k])))
-        body = plate.body("plate")
-        origin = np.asarray(body.position[k])
-        for axis, line in enumerate(artist.bodies.axes):
-            tip = line.get_xydata()[1]
-            assert np.allclose((tip - origin) / np.linalg.norm(tip - origin), body.rotation[k][:, axis])
-        tips = artist.bodies.spokes.get_xydata().reshape(-1, 3, 2)[:, 1]
-        assert np.allclose(tips, [plate.point("left_eye").position[k], plate.point("right_eye").position[k]])
-        from ropesim.render import RenderError
-        from ropesim.render.animate import animate
+    plate = turning_body_run(plate_scene(), frames=7, rate=1.1)
+    model = build(plate.scene, solve=False)
+    artist = RopeArtist(Figure().add_subplot(), model, projection(None, 2))
+    k = 4
+    artist.show(np.asarray(plate.x[k]), None, (np.asarray(plate.body_x[k]), np.asarray(plate.body_q[k])))
+    body = plate.body("plate")
+    origin = np.asarray(body.position[k])
+    for axis, line in enumerate(artist.bodies.axes):
+        tip = line.get_xydata()[1]
+        assert np.allclose((tip - origin) / np.linalg.norm(tip - origin), body.rotation[k][:, axis])
+    tips = artist.bodies.spokes.get_xydata().reshape(-1, 3, 2)[:, 1]
+    assert np.allclose(tips, [plate.point("left_eye").position[k], plate.point("right_eye").position[k]])
+    from ropesim.render import RenderError
+    from ropesim.render.animate import animate
 
-        with pytest.raises(RenderError, match="the 3-D view is for 3-D scenes"):
-            animate(plate, tmp_path / "p.gif", view="3d")
-    finally:
-        patch.undo()
+    with pytest.raises(RenderError, match="the 3-D view is for 3-D scenes"):
+        animate(plate, tmp_path / "p.gif", view="3d")
 
 
 # ------------------------------------------------------------------------------------------ export, view, sweep
@@ -354,3 +348,33 @@ def test_a_3d_animation_frame_equals_the_whole_picture_drawn_afresh(spar):
     renderer.canvas.draw()
     assert np.array_equal(fast[1], np.array(renderer.canvas.buffer_rgba()))
     assert not np.array_equal(fast[0], fast[1])
+
+
+def test_every_command_on_a_run_with_a_rigid_body(tmp_path):
+    """The plate on two legs, run by `ropesim run` (its body's state in the run folder, memory-mapped when read):
+    every command exits 0, and what they write of the body is the run's."""
+    from synthetic_system import BODY_2D
+
+    scene = tmp_path / "plate.toml"
+    scene.write_text(BODY_2D)
+    folder = tmp_path / "plate"
+    result = invoke("run", scene, "--set", "integrator.t_end=0.5", "--set", "integrator.method=verlet", "--out",
+                    folder, "-q")
+    assert result.exit_code == 0, result.output
+    traj = ropesim.Trajectory.open(folder)
+    assert traj.body_q.shape == (traj.frames, 1, 4) and np.allclose(np.linalg.norm(traj.body_q, axis=2), 1.0)
+    for args in (("check", scene), ("summary", folder), ("plot", folder), ("frames", folder, "--count", "3"),
+                 ("animate", folder, "--fps", "10"), ("export", folder, "--to", "vtk"),
+                 ("export", folder, "--to", "csv"), ("view", folder, "--no-open")):
+        result = invoke(*args)
+        assert result.exit_code == 0, (args, result.output)
+    assert "body plate free, reference point at (0, -5) m, turned (20) deg; 100 kg; points left_eye, right_eye" \
+        in words(invoke("check", scene).stdout)
+    table = np.genfromtxt(folder / "trajectory_bodies.csv", delimiter=",", skip_header=1)
+    body = traj.body("plate")
+    assert np.allclose(table[:, 2:4], body.position) and np.allclose(table[:, 8], body.angles[:, 0])
+    sets = [d for d in ET.parse(folder / "vtk" / "plate_2d.pvd").getroot().find("Collection").findall("DataSet")
+            if d.get("name") == "bodies"]
+    mesh = meshio.read(folder / "vtk" / sets[-1].get("file"))
+    assert np.allclose(mesh.points[0, :2], body.position[-1]) and np.allclose(mesh.points[0, 2], 0.0)
+    assert np.allclose(mesh.point_data["line_moment"][0], [0.0, 0.0, body.moment[-1, 0]])

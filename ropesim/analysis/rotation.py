@@ -1,44 +1,24 @@
-"""Orientations of rigid bodies: unit quaternions, rotation matrices and the scene's angles, in NumPy.
+"""Orientations of rigid bodies for the analyses and pictures: rotation matrices and the scene's angles of
+quaternions, stacked over a run's frames and bodies, in NumPy.
 
 A body's orientation is the unit quaternion q = (w, x, y, z) that turns its frame into the world's:
-v_world = R(q) v_body. The scene writes an orientation as angles [deg]: in 3-D rotations about x, then y, then z,
-about the fixed axes, so R = Rz(c) Ry(b) Rx(a) (MoorDyn's roll, pitch, yaw order; scipy's
-``Rotation.from_euler("xyz", ...)``); in 2-D one angle about z. q and -q are the same orientation.
-
-Every function takes stacked arrays (a run's frames, its bodies) on the leading axes.
+v_world = R(q) v_body (:mod:`ropesim.model.rotation`, which also turns the scene's angles into quaternions). The
+scene writes an orientation as angles [deg]: in 3-D rotations about x, then y, then z, about the fixed axes, so
+R = Rz(c) Ry(b) Rx(a) (MoorDyn's roll, pitch, yaw order; scipy's ``Rotation.from_euler("xyz", ...)``); in 2-D one
+angle about z. q and -q are the same orientation.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-
-def quaternion_from_angles(angles_deg, dim: int = 3) -> np.ndarray:
-    """The unit quaternions (..., 4) of the scene's angles [deg] (..., 3) in 3-D (about x, then y, then z) or
-    (..., 1) in 2-D (about z)."""
-    angles = np.radians(np.asarray(angles_deg, dtype=float))
-    if dim == 2:
-        zero = np.zeros(angles.shape[:-1])
-        a, b, c = zero, zero, angles[..., 0]
-    else:
-        a, b, c = np.moveaxis(angles, -1, 0)
-    ca, sa, cb, sb, cc, sc = (f(v / 2) for v in (a, b, c) for f in (np.cos, np.sin))
-    # q = qz qy qx, the product written out
-    return np.stack([cc * cb * ca + sc * sb * sa, cc * cb * sa - sc * sb * ca,
-                     cc * sb * ca + sc * cb * sa, sc * cb * ca - cc * sb * sa], axis=-1)
+from ..model.rotation import rotation_matrix as _matrix
 
 
 def rotation_matrix(q, dim: int = 3) -> np.ndarray:
     """R(q) (..., 3, 3) of quaternions q (..., 4), each divided by its norm first; with ``dim`` 2 its upper-left
     (..., 2, 2) block (a 2-D body turns about z)."""
-    q = np.asarray(q, dtype=float)
-    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
-    w, x, y, z = np.moveaxis(q, -1, 0)
-    r = np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=-1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=-1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=-1)], axis=-2)
-    return r[..., :dim, :dim]
+    return _matrix(q)[..., :dim, :dim]
 
 
 def angles_from_quaternion(q, dim: int = 3) -> np.ndarray:
@@ -49,7 +29,7 @@ def angles_from_quaternion(q, dim: int = 3) -> np.ndarray:
     if dim == 2:
         turn = 2.0 * np.arctan2(q[..., 3], q[..., 0])
         return np.degrees(np.arctan2(np.sin(turn), np.cos(turn)))[..., None]
-    r = rotation_matrix(q)
+    r = _matrix(q)
     cos_b = np.hypot(r[..., 2, 1], r[..., 2, 2])
     b = np.arctan2(-r[..., 2, 0], cos_b)
     locked = cos_b < 1e-9

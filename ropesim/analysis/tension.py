@@ -97,7 +97,9 @@ def windowed_figures(traj, start: float | None = None, stop: float | None = None
         stats = window_statistics(magnitude, slice(0, len(t)))
         out["supports"] = [{name: float(values[h]) for name, values in stats.items()} for h in range(magnitude.shape[1])]
         if traj.scene.is_system:
-            out["support_labels"] = support_labels(traj.scene)
+            from ..model.build import build
+
+            out["support_labels"] = support_labels(traj.scene, build(traj.scene, solve=False).held_idx)
         largest = max(largest, float(stats["max"].max()))
     out["unit"] = force_unit(largest)[0]
     return out
@@ -129,13 +131,14 @@ def end_columns(model) -> list[tuple[str, int]]:
     return out
 
 
-def support_labels(scene) -> list[str]:
-    """A system's supports (its held nodes, in node order) by the point that holds them and the line end there:
+def support_labels(scene, held) -> list[str]:
+    """A system's supports, its held nodes ``held`` (in node order: a fixed or driven point's line ends, and
+    those on a fixed or driven body's points), each by the point that holds it and the line end there:
     "anchor1 (line1's start)"."""
     from ..model.layout import line_layouts
 
-    ends = []
+    ends = {}
     for line, layout in zip(scene.lines, line_layouts(scene)):
-        ends += [(layout.first, line.start, f"{line.id}'s start"), (layout.end - 1, line.end, f"{line.id}'s end")]
-    kinds = {p.id: p.kind for p in scene.points}
-    return [f"{point} ({what})" for _, point, what in sorted(ends) if kinds[point] in ("fixed", "driven")]
+        ends[layout.first] = f"{line.start} ({line.id}'s start)"
+        ends[layout.end - 1] = f"{line.end} ({line.id}'s end)"
+    return [ends.get(int(node), f"node {int(node)}") for node in held]

@@ -125,9 +125,15 @@ def summary_rows(summary: dict) -> list[tuple[str, str]]:
         rows.append(("tension", f"{tension['start_N']:.4g} N at node 0's end, {tension['end_N']:.4g} N at the "
                                 f"other at t_end; largest {tension['max_N']:.4g} N (segment {tension['max_segment']}, "
                                 f"t = {tension['max_t_s']:.3g} s)"))
-    for line, figures in (summary.get("lines") or {}).items():
-        rows.append((f"tension, {line}", f"{figures['start_N']:.4g} N at its start, {figures['end_N']:.4g} N at its "
-                                         f"end at t_end; largest {figures['max_N']:.4g} N (its segment "
+    lines = summary.get("lines") or {}
+    if lines:
+        from ..analysis.tension import force_unit
+
+        unit, scale = force_unit(max(abs(figures["max_N"]) for figures in lines.values()))
+    for line, figures in lines.items():
+        rows.append((f"tension, {line}", f"{figures['start_N'] / scale:.4g} {unit} at its start, "
+                                         f"{figures['end_N'] / scale:.4g} {unit} at its end at t_end; largest "
+                                         f"{figures['max_N'] / scale:.4g} {unit} (its segment "
                                          f"{figures['max_segment']}, t = {figures['max_t_s']:.3g} s)"))
     ledger = summary.get("energy_ledger")
     if ledger:

@@ -226,8 +226,8 @@ def _history(traj, path: Path, window: slice) -> None:
     if system:
         columns = ["t [s]"] + [_csv_text(f"tension {line.id} {which} [{unit}]") for line in traj.scene.lines
                                for which in ("start", "end")]
-        columns += [_csv_text(f"support {label} F{a} [{unit}]") for label in support_labels(traj.scene)
-                    for a in AXES[:dim]] if held.size else []
+        columns += [_csv_text(f"support {label} F{a} [{unit}]") for label in support_labels(traj.scene, held)
+                    for a in AXES[:dim]]
     else:
         last = traj.tension.shape[1] - 1
         columns = ["t [s]", f"tension segment 0 [{unit}]", f"tension segment {last} [{unit}]"]

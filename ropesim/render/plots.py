@@ -21,6 +21,7 @@ from typing import Callable
 import numpy as np
 
 from ..analysis.summary import block_frames
+from ..model.bodies import free_body_state
 from ..model.energy import energy_terms
 from ..analysis.towed import exact_steady_state, segment_angles, shape_verdict, towed_end
 from ..model.build import Model, build
@@ -37,10 +38,11 @@ PANEL_HEIGHT = 250   # [px] per panel
 HEADER = 40          # [px] the title
 
 
-def per_frame(traj: Trajectory, fn: Callable[[np.ndarray, np.ndarray], np.ndarray | dict]):
-    """``fn(x, v)`` over blocks of frames ((B, N, D) each), joined along the frame axis (arrays or dicts)."""
+def per_frame(traj: Trajectory, fn: Callable[..., np.ndarray | dict], with_frames: bool = False):
+    """``fn(x, v)`` over blocks of frames ((B, N, D) each), joined along the frame axis (arrays or dicts); with
+    ``with_frames``, ``fn(x, v, block)``, ``block`` the block's slice of the frames."""
     blocks = frame_blocks(traj.frames, frame_nbytes=traj.x[0].nbytes)
-    parts = [fn(np.asarray(traj.x[sl]), np.asarray(traj.v[sl])) for sl in blocks]
+    parts = [fn(np.asarray(traj.x[sl]), np.asarray(traj.v[sl]), *((sl,) if with_frames else ())) for sl in blocks]
     if isinstance(parts[0], dict):
         return {key: np.concatenate([p[key] for p in parts]) for key in parts[0]}
     return np.concatenate(parts)
@@ -63,7 +65,8 @@ def last_finite_frame(traj: Trajectory) -> int:
 
 
 def draw_energy(ax, traj: Trajectory, model: Model) -> None:
-    terms = per_frame(traj, lambda x, v: energy_terms(model, x, v))
+    terms = per_frame(traj, lambda x, v, block: energy_terms(model, x, v, *free_body_state(model, traj, block)),
+                      with_frames=True)
     for name, values in terms.items():
         if name == "total":
             ax.plot(traj.t, values, color="black", linewidth=1.8, label="total")
@@ -89,7 +92,7 @@ def draw_ledger(ax, traj: Trajectory, model: Model) -> None:
     if traj.ledger is not None:   # the frames' own flows (a window of the run has only its own)
         flows = traj.ledger
     n = min(len(flows), traj.frames)
-    series = ledger_series(model, traj.x, traj.v, flows[:n], energy0)
+    series = ledger_series(model, traj.x, traj.v, flows[:n], energy0, traj)
     t = traj.t[:n]
     ax.plot(t, series["total"] - energy0, color="black", linewidth=1.6, label="E(t) - E(0)")
     ax.plot(t, series["held_work"], linewidth=1.1, label="work by held nodes")
