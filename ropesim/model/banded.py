@@ -114,19 +114,32 @@ def band_solve_columns(band, p, z):
     """Solve L L^T Z = z in place for every column of ``z`` (nt, m) at once: the same operations, in the same
     order, as :func:`band_solve` on each column, with each entry of L loaded once for all columns."""
     nt, m = z.shape
-    for i in range(nt):
-        for k in range(max(0, i - p), i):
+    substitute_columns_down(band, p, z, 0, nt, 0, 0, m)
+    substitute_columns_up(band, p, z, 0, nt, nt, 0, m)
+
+
+@jit.kernel
+def substitute_columns_down(band, p, z, r0, r1, lo, c0, c1):
+    """:func:`substitute_down` on columns c0 .. c1 - 1 of ``z`` (rows, columns) at once, each entry of the
+    factor loaded once for all of them."""
+    for i in range(lo, r1):
+        for k in range(max(lo, r0, i - p), i):
             lik = band[i - k, k]
-            for c in range(m):
+            for c in range(c0, c1):
                 z[i, c] -= lik * z[k, c]
-        for c in range(m):
+        for c in range(c0, c1):
             z[i, c] /= band[0, i]
-    for i in range(nt - 1, -1, -1):
-        for k in range(i + 1, min(nt, i + p + 1)):
+
+
+@jit.kernel
+def substitute_columns_up(band, p, z, r0, r1, hi, c0, c1):
+    """:func:`substitute_up` on columns c0 .. c1 - 1 of ``z`` (rows, columns) at once."""
+    for i in range(hi - 1, r0 - 1, -1):
+        for k in range(i + 1, min(hi, r1, i + p + 1)):
             lki = band[k - i, i]
-            for c in range(m):
+            for c in range(c0, c1):
                 z[i, c] -= lki * z[k, c]
-        for c in range(m):
+        for c in range(c0, c1):
             z[i, c] /= band[0, i]
 
 

@@ -54,7 +54,7 @@ pivoting (:func:`lu_factor`).
 
 Storage (:class:`Groups`): the groups' constrained nodes (members), their arms and groups; per line the member
 on each end ("slot" 0 for its first node, 1 for its last) and the direction its block is factored in; W, one
-row per slot column (2 k_max, N D), k_max a group's largest number of unknowns; S, its pivots, O and o_u.
+column per slot's unknown (N D, 2 k_max), k_max a group's largest number of unknowns; S, its pivots, O and o_u.
 """
 
 from __future__ import annotations
@@ -65,7 +65,8 @@ from collections import namedtuple
 import numpy as np
 
 from . import jit
-from .banded import band_cholesky_range, band_cholesky_reverse, substitute_down, substitute_up
+from .banded import (band_cholesky_range, band_cholesky_reverse, substitute_columns_down, substitute_columns_up,
+                     substitute_down, substitute_up)
 
 Groups = namedtuple("Groups", ["start", "nodes", "arm", "group", "member", "offset", "slots", "reverse", "rows",
                                "w", "s", "piv", "own", "own_rhs", "du"])
@@ -75,9 +76,9 @@ rho_c from its body's reference point (zero on a point; kept up to date by the i
 each member's group; member (N,) int64, each node's member or -1. offset (G + 1,) int64: group g's unknowns
 are u[offset[g]:offset[g + 1]]. Lines: slots (L, 2) int64, the member on each line's first and last node or
 -1; reverse (L,) bool, the line's block factored from its last node; rows (L, 2, 2) int64, the rows [lo, hi)
-of the matrix where each slot's columns of W may be nonzero. Scratch: w (2 k_max, N D), s (m, m), piv (m,)
+of the matrix where each slot's columns of W may be nonzero. Scratch: w (N D, 2 k_max), s (m, m), piv (m,)
 int64, du (m,). Filled by the integrator: own (m, m), the groups' own blocks O; own_rhs (m,), their own
-residual o_u (both zero for points)."""
+residual o_u (both zero for points). Slot s's columns of W are ``w[:, s k_max:(s + 1) k_max]``."""
 
 
 def groups_of(lines, members: list[tuple[int, list[int], np.ndarray | None]], dim: int, w: int,
@@ -112,7 +113,7 @@ def groups_of(lines, members: list[tuple[int, list[int], np.ndarray | None]], di
     k_max = max((dof for dof, _, _ in members), default=0)
     m = int(offset[-1])
     return Groups(start, node_of, arm, group, member, offset, slots, reverse, rows,
-                  np.zeros((2 * k_max, nodes * dim)), np.zeros((m, m)), np.zeros(m, dtype=np.int64),
+                  np.zeros((nodes * dim, 2 * k_max)), np.zeros((m, m)), np.zeros(m, dtype=np.int64),
                   np.zeros((m, m)), np.zeros(m), np.zeros(m))
 
 
@@ -205,7 +206,7 @@ def schur_factor(band, w, lines, groups):
     p = band.shape[0] - 1
     dim = (p + 1) // (w + 1)
     m = s.shape[0]
-    k_max = wmat.shape[0] // 2
+    k_max = wmat.shape[1] // 2
     for a in range(m):
         for b in range(m):
             s[a, b] = own[a, b]
@@ -219,9 +220,9 @@ def schur_factor(band, w, lines, groups):
             g = group[k]
             dof = offset[g + 1] - offset[g]
             lo, hi = rows[line, slot, 0], rows[line, slot, 1]
-            for col in range(slot * k_max, slot * k_max + dof):
-                for r in range(lo, hi):
-                    wmat[col, r] = 0.0
+            for r in range(lo, hi):
+                for col in range(slot * k_max, slot * k_max + dof):
+                    wmat[r, col] = 0.0
             for j in range(max(first, c - w), min(end, c + w + 1)):
                 other = member[j]
                 if other < 0:        # a line node: its coupling to the group, B[j, :] = J[j, c] G_c
@@ -230,7 +231,7 @@ def schur_factor(band, w, lines, groups):
                             val = 0.0
                             for b in range(dim):
                                 val += entry(band, j * dim + a, c * dim + b) * lever(arm, k, dim, dof, b, col)
-                            wmat[slot * k_max + col, j * dim + a] = val
+                            wmat[j * dim + a, slot * k_max + col] = val
                     continue
                 g2 = group[other]     # another constrained node (or c itself): G_c^T J[c, j] G_j into C
                 dof2 = offset[g2 + 1] - offset[g2]
@@ -269,11 +270,10 @@ def schur_factor(band, w, lines, groups):
                 continue
             dof = offset[group[k] + 1] - offset[group[k]]
             lo, hi = rows[line, slot, 0], rows[line, slot, 1]
-            for col in range(slot * k_max, slot * k_max + dof):
-                if reverse[line]:
-                    substitute_up(band, p, wmat[col], r0, r1, hi)
-                else:
-                    substitute_down(band, p, wmat[col], r0, r1, lo)
+            if reverse[line]:
+                substitute_columns_up(band, p, wmat, r0, r1, hi, slot * k_max, slot * k_max + dof)
+            else:
+                substitute_columns_down(band, p, wmat, r0, r1, lo, slot * k_max, slot * k_max + dof)
         for slot in range(2):             # S -= W_slot^T W_slot2 over the rows where both may be nonzero
             k = slots[line, slot]
             if k < 0:
@@ -286,12 +286,12 @@ def schur_factor(band, w, lines, groups):
                 g2 = group[k2]
                 lo = max(rows[line, slot, 0], rows[line, slot2, 0])
                 hi = min(rows[line, slot, 1], rows[line, slot2, 1])
-                for col in range(offset[g + 1] - offset[g]):
-                    for col2 in range(offset[g2 + 1] - offset[g2]):
-                        val = 0.0
-                        for r in range(lo, hi):
-                            val += wmat[slot * k_max + col, r] * wmat[slot2 * k_max + col2, r]
-                        s[offset[g] + col, offset[g2] + col2] -= val
+                dof, dof2 = offset[g + 1] - offset[g], offset[g2 + 1] - offset[g2]
+                for r in range(lo, hi):
+                    for col in range(dof):
+                        wr = wmat[r, slot * k_max + col]
+                        for col2 in range(dof2):
+                            s[offset[g] + col, offset[g2] + col2] -= wr * wmat[r, slot2 * k_max + col2]
     return lu_factor(s, piv)
 
 
@@ -305,7 +305,7 @@ def schur_solve(band, w, lines, groups, rhs):
                                               groups.piv, groups.du)
     p = band.shape[0] - 1
     dim = (p + 1) // (w + 1)
-    k_max = wmat.shape[0] // 2
+    k_max = wmat.shape[1] // 2
     for a in range(du.shape[0]):
         du[a] = groups.own_rhs[a]
     for k in range(nodes.shape[0]):
@@ -329,11 +329,11 @@ def schur_solve(band, w, lines, groups, rhs):
             if k < 0:
                 continue
             g = group[k]
-            for col in range(offset[g + 1] - offset[g]):
-                val = 0.0
-                for r in range(rows[line, slot, 0], rows[line, slot, 1]):
-                    val += wmat[slot * k_max + col, r] * rhs[r]
-                du[offset[g] + col] -= val
+            first, dof = offset[g], offset[g + 1] - offset[g]
+            for r in range(rows[line, slot, 0], rows[line, slot, 1]):
+                f = rhs[r]
+                for col in range(dof):
+                    du[first + col] -= wmat[r, slot * k_max + col] * f
     lu_solve(s, piv, du)
     for line in range(lines.shape[0]):    # dx_f = F^-T (f - W du)
         r0, r1 = lines[line, 0] * dim, lines[line, 1] * dim
@@ -342,10 +342,12 @@ def schur_solve(band, w, lines, groups, rhs):
             if k < 0:
                 continue
             g = group[k]
-            for col in range(offset[g + 1] - offset[g]):
-                step = du[offset[g] + col]
-                for r in range(rows[line, slot, 0], rows[line, slot, 1]):
-                    rhs[r] -= wmat[slot * k_max + col, r] * step
+            first, dof = offset[g], offset[g + 1] - offset[g]
+            for r in range(rows[line, slot, 0], rows[line, slot, 1]):
+                val = 0.0
+                for col in range(dof):
+                    val += wmat[r, slot * k_max + col] * du[first + col]
+                rhs[r] -= val
         if reverse[line]:
             substitute_down(band, p, rhs, r0, r1, r0)
         else:
