@@ -82,8 +82,8 @@ def warm_up(scene) -> None:
     model = build(short)                  # a scene starting in equilibrium runs (and compiles) the static solver
     integrator = make_integrator(model, TimeGrid.of(short))
     integrator.warm_up()                  # the loop, outside the run's signal handling: Ctrl-C stops it
-    store = FrameStore(0, model.nodes, model.dim, derive=lambda t, x, v: frame_arrays(model, t, x, v))
-    store.rows(np.zeros(1), integrator.x[None], integrator.v[None], None)   # as the run derives its frames
+    store = FrameStore(0, model.nodes, model.dim, derive=lambda t, x, v, body: frame_arrays(model, t, x, v, body))
+    store.rows(np.zeros(1), integrator.x[None], integrator.v[None], None, integrator.body_rows()[None])   # as the run derives its frames
     summary = simulate(short).summary
     if summary["status"] == INTERRUPTED:
         raise Stopped(summary.get("stopped_by", "SIGINT"))

@@ -108,7 +108,8 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
         if integrator is None:
             integrator = make_integrator(model, grid)
         if integrator.step == 0 and store.count == 0:
-            store.append(np.zeros(1), integrator.x[None], integrator.v[None], np.zeros((1, len(LEDGER_COLUMNS))))
+            store.append(np.zeros(1), integrator.x[None], integrator.v[None], np.zeros((1, len(LEDGER_COLUMNS))),
+                         integrator.body_rows()[None])
             if on_chunk is not None:
                 on_chunk(integrator, 0.0)
         status, bad_node, message, code = "completed", -1, "", OK
@@ -126,7 +127,8 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
             tick = time.perf_counter()
             done, written, code, node = integrator.advance(n, frames)
             chunks.measured(done, time.perf_counter() - tick)
-            store.append(frames[0][:written], frames[1][:written], frames[2][:written], frames[3][:written])
+            store.append(frames.t[:written], frames.x[:written], frames.v[:written], frames.ledger[:written],
+                         frames.body[:written])
             if code != OK:
                 status, bad_node = BLEW_UP, node
                 break
@@ -348,7 +350,7 @@ def _run_in_memory(model: Model, grid: TimeGrid, progress: bool, stop, before_ba
     from .model.tension import frame_arrays
 
     specs = frame_specs(model)
-    store = FrameStore(grid.frames, model.nodes, model.dim, derive=lambda t, x, v: frame_arrays(model, t, x, v),
+    store = FrameStore(grid.frames, model.nodes, model.dim, derive=lambda t, x, v, body: frame_arrays(model, t, x, v, body),
                        shapes={k: s for k, s in specs.items() if k not in ("t", "x", "v", "ledger")})
     with _progress(progress, model.scene, before_bar) as on_progress:
         outcome = integrate(model, store, on_progress, stop=stop)
@@ -358,12 +360,12 @@ def _run_in_memory(model: Model, grid: TimeGrid, progress: bool, stop, before_ba
 def _in_memory(model: Model, arrays: dict, outcome: RunOutcome, **more) -> "Trajectory":
     """A trajectory held in memory from the run's frame arrays, with its summary (and ``more`` in it)."""
     from .analysis.summary import summarize
-    from .io.trajectory import Trajectory
+    from .io.trajectory import DERIVED, Trajectory
 
-    summary = summarize(model, outcome, arrays["t"], arrays["x"], arrays["v"], arrays["tension"])
+    summary = summarize(model, outcome, arrays["t"], arrays["x"], arrays["v"], arrays["tension"], arrays)
     _stopped_by(summary, outcome)
     summary.update(more)
-    extra = {k: v for k, v in arrays.items() if k in ("tension", "strain", "support", "ledger")}
+    extra = {k: v for k, v in arrays.items() if k in (*DERIVED, "ledger")}
     return Trajectory(t=arrays["t"], x=arrays["x"], v=arrays["v"], scene=model.scene, summary=summary, **extra)
 
 
@@ -386,7 +388,7 @@ class _DiskStore:
         from .model.tension import frame_arrays
 
         self.writer, self.seconds = writer, seconds
-        self.rows = FrameStore(0, model.nodes, model.dim, derive=lambda t, x, v: frame_arrays(model, t, x, v)).rows
+        self.rows = FrameStore(0, model.nodes, model.dim, derive=lambda t, x, v, body: frame_arrays(model, t, x, v, body)).rows
         self.last = -float("inf")
         self.wall0 = float(previous.get("wall_time_s", 0.0))
         self.compile0 = float(previous.get("compile_time_s", 0.0))
@@ -414,10 +416,10 @@ class _DiskStore:
             error, self.error = self.error, None
             raise error
 
-    def append(self, t, x_dn, v_dn, ledger=None) -> None:
+    def append(self, t, x_dn, v_dn, ledger=None, body=None) -> None:
         self._raise()
         if len(t):
-            self.queue.put((t, x_dn, v_dn, ledger))
+            self.queue.put((t, x_dn, v_dn, ledger, body))
 
     def drain(self) -> None:
         self.queue.join()
@@ -481,7 +483,7 @@ def _run_in_folder(model: Model, grid: TimeGrid, writer, integrator: Integrator 
             outcome.wall_time += store.wall0
             outcome.compile_time += store.compile0
             arrays = writer.arrays()
-            summary = summarize(model, outcome, arrays["t"], arrays["x"], arrays["v"], arrays["tension"])
+            summary = summarize(model, outcome, arrays["t"], arrays["x"], arrays["v"], arrays["tension"], arrays)
             _stopped_by(summary, outcome)
             if outcome.status == INTERRUPTED:
                 writer.mark(INTERRUPTED, outcome.message, summary)

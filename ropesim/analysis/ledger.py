@@ -23,6 +23,7 @@ import numpy as np
 from ..io.runfolder import LEDGER
 from ..model.build import Model
 from ..integrate.health import LEDGER_COLUMNS
+from ..model.bodies import free_body_state
 from ..model.energy import energy_terms
 
 FRAME_BLOCK = 256
@@ -47,12 +48,17 @@ def write_ledger(folder: Path, t: np.ndarray, flows: np.ndarray, energy0: float)
     write_npz_atomic(Path(folder) / LEDGER, ledger_arrays(t, flows, energy0))
 
 
-def ledger_series(model: Model, x: np.ndarray, v: np.ndarray, flows: np.ndarray, energy0: float) -> dict:
+def ledger_series(model: Model, x: np.ndarray, v: np.ndarray, flows: np.ndarray, energy0: float,
+                  bodies=None) -> dict:
     """Every term of the ledger per frame [J]: the energy terms, the flows and the residual.
 
-    ``x``, ``v`` are (F, N, D) frames (possibly memory-mapped; read in blocks), ``flows`` (F, C).
+    ``x``, ``v`` are (F, N, D) frames (possibly memory-mapped; read in blocks), ``flows`` (F, C); ``bodies`` what
+    holds the rigid bodies' per-frame arrays (a Trajectory or a dict; see
+    :func:`ropesim.model.bodies.free_body_state`), needed when the scene has free bodies.
     """
-    blocks = [energy_terms(model, x[s:s + FRAME_BLOCK], v[s:s + FRAME_BLOCK]) for s in range(0, len(flows), FRAME_BLOCK)]
+    blocks = [energy_terms(model, x[s:s + FRAME_BLOCK], v[s:s + FRAME_BLOCK],
+                           *free_body_state(model, bodies, slice(s, s + FRAME_BLOCK)))
+              for s in range(0, len(flows), FRAME_BLOCK)]
     out = {key: np.concatenate([b[key] for b in blocks]) for key in blocks[0]} if blocks else {}
     for c, name in enumerate(LEDGER_COLUMNS):
         out[name] = flows[:, c]

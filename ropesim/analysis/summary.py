@@ -43,9 +43,10 @@ def largest_stretch(model: Model, x: np.ndarray) -> tuple[float, float]:
 
 
 def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray,
-              tension: np.ndarray | None = None) -> dict:
+              tension: np.ndarray | None = None, bodies: dict | None = None) -> dict:
     """Everything a user wants to know about a finished (or stopped) run, as JSON-ready values; with the frames'
-    ``tension`` (F, S) also the tension at both ends and the largest (see :mod:`ropesim.analysis.tension`)."""
+    ``tension`` (F, S) also the tension at both ends and the largest (see :mod:`ropesim.analysis.tension`);
+    ``bodies`` the rigid bodies' per-frame arrays (body_x, ...), for the energy ledger."""
     scene = model.scene
     grid = outcome.grid
     node_steps = outcome.steps * model.nodes
@@ -75,8 +76,8 @@ def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray
     if finite:
         with np.errstate(over="ignore", invalid="ignore"):  # a run stopped by a blow-up may end huge
             summary.update(_physics_figures(model, t, x, v))
-            summary["energy_ledger"] = ledger_summary(ledger_series(model, x, v, outcome.ledger, outcome.energy0),
-                                                      outcome.energy0)
+            summary["energy_ledger"] = ledger_summary(ledger_series(model, x, v, outcome.ledger, outcome.energy0,
+                                                                    bodies), outcome.energy0)
             if tension is not None and len(tension):
                 block = block_frames(tension[0].nbytes)
                 if scene.is_system:

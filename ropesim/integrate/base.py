@@ -68,6 +68,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..model.bodies import STATE_ROWS, place_attachments
 from ..model.jit import specialise
 from ..model.motion import place_moving
 from .health import LEDGER_COLUMNS, OK, initial_ledger, limits
@@ -78,8 +79,13 @@ Schedule = namedtuple("Schedule", ["step0", "n_steps", "total_steps", "h", "save
 """Which steps a call runs: from global step ``step0``, ``n_steps`` steps of ``h`` [s] out of ``total_steps``;
 a frame every ``save_every`` steps and at the last, a health check every ``check_every``."""
 
-Frames = namedtuple("Frames", ["t", "x", "v", "ledger"])
-"""Frame buffers of one call: t (F,) [s], x and v (F, D, N) [m, m/s], the ledger's flows (F, 3) [J]."""
+Frames = namedtuple("Frames", ["t", "x", "v", "ledger", "body"])
+"""Frame buffers of one call: t (F,) [s], x and v (F, D, N) [m, m/s], the ledger's flows (F, C) [J], the free
+rigid bodies' pose and twist (F, 13, B) (:mod:`ropesim.model.bodies`)."""
+
+BodyState = namedtuple("BodyState", ["pose", "twist"])
+"""The free rigid bodies' state: pose (7, B) (reference point, orientation quaternion), twist (6, B) (velocity,
+angular velocity in world axes); see :mod:`ropesim.model.bodies`."""
 
 Held = namedtuple("Held", ["idx", "x0", "v", "motion"])
 """The held (pinned or driven) nodes: indices (H,), positions at t = 0 (D, H) [m], velocities (D, H) [m/s]
@@ -183,8 +189,13 @@ class Integrator:
         motion = model.motion._replace(accel=model.motion.accel.copy())
         self.held = Held(model.held_idx, model.held_x0, model.held_v.copy(), motion)
         if motion.moving:
-            place_moving(self.x, self.v, self.held, 0.0, 0.0)   # a sinusoid starts with its own velocity
-        self.ledger = initial_ledger(model, self.x, self.v)
+            model.kernel(place_moving)(self.x, self.v, self.held, 0.0, 0.0)   # a sinusoid starts with its own velocity
+        self.pose = model.body_pose0.copy()
+        self.twist = model.body_twist0.copy()
+        self.bodies = BodyState(self.pose, self.twist)
+        if self.pose.shape[1]:
+            place_attachments(self.x, self.v, model.params.bodies, self.pose, self.twist)
+        self.ledger = initial_ledger(model, self.x, self.v, self.pose, self.twist)
         self.limits = limits(model)
         self.switches = self.switches_for(model, method)
         self.loop = self.kernel(self.template())
@@ -242,7 +253,7 @@ class Integrator:
         k = self.frames_in(n)
         dim, nodes = self.x.shape
         return Frames(np.zeros(k), np.zeros((k, dim, nodes)), np.zeros((k, dim, nodes)),
-                      np.zeros((k, len(LEDGER_COLUMNS))))
+                      np.zeros((k, len(LEDGER_COLUMNS))), np.zeros((k, STATE_ROWS, self.pose.shape[1])))
 
     def advance(self, n: int, frames: Frames | None = None) -> Advance:
         """Run ``n`` steps (fewer if the state goes bad), saving the frames due into ``frames``."""
@@ -258,10 +269,18 @@ class Integrator:
         self.advance(0)
         return time.perf_counter() - start
 
+    @property
+    def _state_names(self) -> tuple[str, ...]:
+        return ("x", "v", "ledger", *(("pose", "twist") if self.pose.shape[1] else ()), *self.STATE)
+
+    def body_rows(self) -> np.ndarray:
+        """The free rigid bodies' state now (13, B): pose, then twist (a saved frame's body rows)."""
+        return np.concatenate([self.pose, self.twist])
+
     def state(self) -> dict[str, np.ndarray]:
         """The complete state, as named arrays (copies): restoring it continues the run bit for bit."""
         out = {"step": np.array(self.step, dtype=np.int64)}
-        for name in ("x", "v", "ledger", *self.STATE):
+        for name in self._state_names:
             out[name] = np.array(getattr(self, name), copy=True)
         return out
 
@@ -270,8 +289,10 @@ class Integrator:
 
         Arrays are copied into place, so the bundles the compiled loop holds keep pointing at them.
         """
-        for name in ("x", "v", "ledger", *self.STATE):
+        for name in self._state_names:
             mine = getattr(self, name)
+            if name not in state:
+                raise ValueError(f"saved state has no {name!r}")
             theirs = np.asarray(state[name])
             if theirs.shape != mine.shape or theirs.dtype != mine.dtype:
                 raise ValueError(f"saved state {name!r} has shape {theirs.shape} ({theirs.dtype}); this run needs "

@@ -24,7 +24,8 @@ import numpy as np
 
 from ..model import jit
 from ..model.motion import place_moving
-from ..model.terms import WITH_MOTION, mechanical_energy
+from ..model.bodies import WITH_BODIES, save_bodies
+from ..model.terms import WITH_MOTION, bodies_energy, mechanical_energy
 
 OK, NON_FINITE, OVERSTRETCH, RUNAWAY_ENERGY, NEWTON_FAILED = 0, 1, 2, 3, 4
 STATUS_NAMES = {OK: "ok", NON_FINITE: "non-finite", OVERSTRETCH: "overstretched", RUNAWAY_ENERGY: "runaway energy",
@@ -57,9 +58,12 @@ def first_non_finite(x):
 
 
 @jit.kernel(inline="always")
-def check_health(x, v, mass, params, ledger, limits):
-    """(status, node): OK and -1 when the state is sane, else the first problem found (see the module doc)."""
+def check_health(x, v, mass, params, ledger, limits, bodies):
+    """(status, node): OK and -1 when the state is sane, else the first problem found (see the module doc);
+    ``bodies`` the free rigid bodies' state (:class:`ropesim.integrate.base.BodyState`)."""
     energy, stretch, node = mechanical_energy(x, v, mass, params)
+    if WITH_BODIES:
+        energy += bodies_energy(params, bodies.pose, bodies.twist)
     return verdict(energy, stretch, node, x, v, ledger, limits)
 
 
@@ -172,19 +176,21 @@ def power(acc, v, mass):
 
 
 @jit.kernel
-def end_step(done, schedule, x, v, mass, params, ledger, limits, frames, frame):
+def end_step(done, schedule, x, v, mass, params, ledger, limits, frames, frame, bodies):
     """After global step ``done`` (1-based): check the state when due and save a frame when due.
 
-    ``schedule`` and ``frames`` are the bundles of :mod:`ropesim.integrate.base`. Returns (status, node,
-    frames written so far).
+    ``schedule``, ``frames`` and ``bodies`` are the bundles of :mod:`ropesim.integrate.base`. Returns (status,
+    node, frames written so far).
     """
     saving = done % schedule.save_every == 0 or done == schedule.total_steps
     if saving or done % schedule.check_every == 0:
-        status, node = check_health(x, v, mass, params, ledger, limits)
+        status, node = check_health(x, v, mass, params, ledger, limits, bodies)
         if status != OK:
             return status, node, frame
     if saving:
         save_frame(frame, done * schedule.h, x, v, ledger, frames.t, frames.x, frames.v, frames.ledger)
+        if WITH_BODIES:
+            save_bodies(frame, bodies.pose, bodies.twist, frames.body)
         frame += 1
     return OK, -1, frame
 
@@ -207,12 +213,14 @@ RUNAWAY_FLOW_FRACTION = 0.2  # ... plus this fraction of the energy that flowed 
 STRETCH_SANITY = 4.0      # a spring longer than this many rest lengths (or 4x its static strain) is a blow-up
 
 
-def initial_ledger(model, x: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """A new ledger (LEDGER_SIZE,): no flows yet, the mechanical energy of (x, v) (D, N) and the energy scale."""
+def initial_ledger(model, x: np.ndarray, v: np.ndarray, pose: np.ndarray | None = None,
+                   twist: np.ndarray | None = None) -> np.ndarray:
+    """A new ledger (LEDGER_SIZE,): no flows yet, the mechanical energy of (x, v) (D, N) (and of the free bodies
+    at pose (7, B) and twist (6, B)) and the energy scale."""
     from ..model.energy import energy_terms
 
     ledger = np.zeros(LEDGER_SIZE)
-    ledger[E0] = float(energy_terms(model, x.T, v.T)["total"])
+    ledger[E0] = float(energy_terms(model, x.T, v.T, pose, twist)["total"])
     ledger[SCALE] = energy_scale(model)
     return ledger
 
@@ -236,7 +244,12 @@ def energy_scale(model) -> float:
     moving = float(terms["total"] - terms.get("gravity", 0.0))
     length = sum(line.nodes * line.segment_length for line in model.lines)
     stretched = sum(line.nodes * 0.5 * line.stiffness * (0.01 * line.segment_length) ** 2 for line in model.lines)
-    return abs(moving) + float(model.mass.sum()) * g * length + stretched
+    return abs(moving) + total_mass(model) * g * length + stretched
+
+
+def total_mass(model) -> float:
+    """Every node's mass and every free rigid body's [kg]."""
+    return float(model.mass.sum()) + float(model.params.bodies.mass.sum())
 
 
 def stretch_limit(model) -> float:
@@ -251,7 +264,7 @@ def stretch_limit(model) -> float:
 
     scene, rope = model.scene, model.scene.rope
     g = scene.gravity.g if scene.gravity is not None else 0.0
-    load = float(model.mass.sum()) * g
+    load = total_mass(model) * g
     if model.held_v.size:
         load += float(model.drag.sum()) * float(np.abs(model.held_v).max())
     if scene.thrower is not None:

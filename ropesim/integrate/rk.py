@@ -6,6 +6,12 @@ are placed at x0 + V (t + c_i h) at every stage, with stage velocity V and no ac
 
     Y_s = y + h sum_{j<s} a_sj K_j,   K_s = F(t + c_s h, Y_s),   y <- y + h sum_s b_s K_s.
 
+Free rigid bodies are stepped on their group (Runge-Kutta-Munthe-Kaas): within a step a body's orientation is
+q = exp(phi) q_n, the rotation vector phi starting at 0 with the rate phi' = dexp^-1_phi(w)
+(:func:`ropesim.model.rotation.dexp_inverse`), so the stages combine phi linearly, as any other coordinate, and
+the step ends with q_(n+1) = exp(phi_(n+1)) q_n, a unit quaternion by construction; the method keeps its order.
+The bodies' attachment nodes are put where their bodies hold them at every stage and at the step's end.
+
 Unlike the splitting schemes these methods are not symplectic: their energy error drifts (RK4 dissipates).
 """
 
@@ -16,8 +22,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.bodies import WITH_BODIES, place_attachments
 from ..model.junctions import WITH_JUNCTIONS
-from ..model.terms import WITH_ADDED_MASS, WITH_APPLIED, accelerations, applied_accelerations, solve_accelerations
+from ..model.rotation import dexp_inverse, turn
+from ..model.terms import (WITH_ADDED_MASS, WITH_APPLIED, accelerations, applied_accelerations, body_accelerations,
+                           solve_accelerations)
 from .base import Integrator, Method
 from .health import BOX, DRAG, FLUID, HELD, INTERNAL, OK, SEABED, due, end_step, held_power, place, power
 from ..model import jit
@@ -73,8 +82,11 @@ RK4 = RungeKutta(
     doc="Classical fourth-order Runge-Kutta, a non-symplectic comparison: 4 force evaluations per step, drag "
         "explicit (so strong drag limits its step too), energy slowly dissipated.")
 
-RKScratch = namedtuple("RKScratch", ["xs", "vs", "kx", "kv", "acc", "acc_box"])
-"""Stage positions and velocities (D, N), stage derivatives (S, D, N), accelerations (D, N)."""
+RKScratch = namedtuple("RKScratch", ["xs", "vs", "kx", "kv", "acc", "acc_box", "pose", "twist", "phi", "kpose",
+                                     "ktwist"])
+"""Stage positions and velocities (D, N), stage derivatives (S, D, N), accelerations (D, N); the free bodies'
+stage pose (7, B), twist (6, B) and rotation vector (3, B), and their stage derivatives (S, 6, B): (v, phi'),
+then (a, alpha)."""
 
 
 class RungeKuttaFamily(Integrator):
@@ -85,8 +97,11 @@ class RungeKuttaFamily(Integrator):
         stages = len(method.b)
         self.tables = method.tables()
         shape = self.x.shape
+        bodies = self.pose.shape[1]
         self.scratch = RKScratch(np.zeros(shape), np.zeros(shape), np.zeros((stages,) + shape),
-                                 np.zeros((stages,) + shape), np.zeros(shape), np.zeros(shape))
+                                 np.zeros((stages,) + shape), np.zeros(shape), np.zeros(shape), np.zeros((7, bodies)),
+                                 np.zeros((6, bodies)), np.zeros((3, bodies)), np.zeros((stages, 6, bodies)),
+                                 np.zeros((stages, 6, bodies)))
         self.gamma = np.where(model.held, 0.0, model.drag / model.mass)
 
     @staticmethod
@@ -100,7 +115,7 @@ class RungeKuttaFamily(Integrator):
     def _run(self, n, frames):
         m = self.model
         return self.loop((self.x, self.v, self.ledger), self.tables, self.scratch, self.held, m.mass, self.gamma,
-                         m.params, self.limits, self.schedule(n), frames)
+                         m.params, self.limits, self.schedule(n), frames, self.bodies)
 
 
 @jit.kernel
@@ -136,15 +151,71 @@ def combine(x, v, kx, kv, b, h):
 
 
 @jit.kernel
-def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedule, frames):
+def body_stage(bodies, scratch, a, st, h):
+    """Stage ``st``'s body state into the scratch's pose, twist and rotation vector: r + h sum_j a[st, j] v_j,
+    phi = h sum_j a[st, j] phi'_j, q = exp(phi) q_n, and the twist likewise."""
+    pose, twist = bodies
+    for b in range(pose.shape[1]):
+        for d in range(6):
+            dp = 0.0
+            dt = 0.0
+            for j in range(st):
+                w = a[st, j] * h
+                if w != 0.0:
+                    dp += w * scratch.kpose[j, d, b]
+                    dt += w * scratch.ktwist[j, d, b]
+            if d < 3:
+                scratch.pose[d, b] = pose[d, b] + dp
+            else:
+                scratch.phi[d - 3, b] = dp
+            scratch.twist[d, b] = twist[d, b] + dt
+        for d in range(4):
+            scratch.pose[3 + d, b] = pose[3 + d, b]
+        turn(scratch.pose[3:7], b, scratch.phi[0, b], scratch.phi[1, b], scratch.phi[2, b])
+
+
+@jit.kernel
+def body_rates(scratch, st):
+    """Stage ``st``'s position-like derivatives: the velocity v and the rotation vector's rate dexp^-1_phi(w)."""
+    twist, phi = scratch.twist, scratch.phi
+    for b in range(twist.shape[1]):
+        for d in range(3):
+            scratch.kpose[st, d, b] = twist[d, b]
+        r0, r1, r2 = dexp_inverse(phi[0, b], phi[1, b], phi[2, b], twist[3, b], twist[4, b], twist[5, b])
+        scratch.kpose[st, 3, b] = r0
+        scratch.kpose[st, 4, b] = r1
+        scratch.kpose[st, 5, b] = r2
+
+
+@jit.kernel
+def combine_bodies(bodies, scratch, b_weights, h):
+    """The step's end for the bodies: r += h sum_s b_s v_s, q <- exp(h sum_s b_s phi'_s) q, twist likewise."""
+    pose, twist = bodies
+    for b in range(pose.shape[1]):
+        for d in range(6):
+            dp = 0.0
+            dt = 0.0
+            for st in range(b_weights.shape[0]):
+                dp += b_weights[st] * scratch.kpose[st, d, b]
+                dt += b_weights[st] * scratch.ktwist[st, d, b]
+            if d < 3:
+                pose[d, b] += h * dp
+            else:
+                scratch.phi[d - 3, b] = h * dp
+            twist[d, b] += h * dt
+        turn(pose[3:7], b, scratch.phi[0, b], scratch.phi[1, b], scratch.phi[2, b])
+
+
+@jit.kernel
+def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedule, frames, bodies):
     """Advance ``schedule.n_steps`` Runge-Kutta steps in place; the contract of :mod:`ropesim.integrate.base`.
 
-    ``state`` = (x, v, ledger); ``tables`` = (a, b, c); ``gamma`` (N,) is b / m (zero for held nodes).
-    Returns (steps done, frames written, status, node).
+    ``state`` = (x, v, ledger); ``tables`` = (a, b, c); ``gamma`` (N,) is b / m (zero for held nodes);
+    ``bodies`` the free rigid bodies' state (pose, twist). Returns (steps done, frames written, status, node).
     """
     x, v, ledger = state
     a, b, c = tables
-    xs, vs, kx, kv, acc, acc_box = scratch
+    xs, vs, kx, kv, acc, acc_box = scratch.xs, scratch.vs, scratch.kx, scratch.kv, scratch.acc, scratch.acc_box
     held_idx, held_v = held.idx, held.v
     h = schedule.h
     dim, n = x.shape
@@ -159,6 +230,10 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
             for j in range(held_idx.shape[0]):
                 for d in range(dim):
                     vs[d, held_idx[j]] = held_v[d, j]
+            if WITH_BODIES:
+                body_stage(bodies, scratch, a, st, h)
+                place_attachments(xs, vs, params.bodies, scratch.pose, scratch.twist)
+                body_rates(scratch, st)
             fluid, internal, seabed = accelerations(xs, vs, acc, params, t + c[st] * h)
             lost = 0.0
             for d in range(dim):
@@ -168,6 +243,9 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
                     lost += gamma[i] * mass[i] * vs[d, i] * vs[d, i]
             if WITH_ADDED_MASS or WITH_JUNCTIONS:
                 fluid += solve_accelerations(xs, vs, kv[st], params)
+            if WITH_BODIES:
+                fluid += body_accelerations(xs, vs, kv[st], params, scratch.pose, scratch.twist, scratch.ktwist[st],
+                                            t + c[st] * h)
             for j in range(held_idx.shape[0]):
                 for d in range(dim):
                     kv[st, d, held_idx[j]] = 0.0
@@ -182,10 +260,13 @@ def advance_rk(state, tables, scratch, held, mass, gamma, params, limits, schedu
                 ledger[BOX] += wh * power(acc_box, vs, mass)
         combine(x, v, kx, kv, b, h)
         place(x, v, held, (step + 1) * h, (step + 1) * h)
+        if WITH_BODIES:
+            combine_bodies(bodies, scratch, b, h)
+            place_attachments(x, v, params.bodies, bodies.pose, bodies.twist)
         done = step + 1
         if not due(done, schedule):
             continue  # nothing due: skip the call, whose array arguments cost more than a small rope's step
-        status, node, frame = end_step(done, schedule, x, v, mass, params, ledger, limits, frames, frame)
+        status, node, frame = end_step(done, schedule, x, v, mass, params, ledger, limits, frames, frame, bodies)
         if status != OK:
             return s + 1, frame, status, node
     return schedule.n_steps, frame, OK, -1

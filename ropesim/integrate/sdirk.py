@@ -137,7 +137,7 @@ class SdirkFamily(Integrator):
 
     def _run(self, n, frames):
         return self.loop((self.x, self.v, self.ledger, self.stats), self.stage, self.newton, self.held, self.nodes,
-                         self.model.params, self.limits, self.schedule(n), frames)
+                         self.model.params, self.limits, self.schedule(n), frames, self.bodies)
 
 
 @jit.kernel
@@ -261,7 +261,7 @@ def solve_stage(stage, newton, beta, t_stage, t_piece, held, nodes, params):
 
 
 @jit.kernel
-def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, frames):
+def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, frames, bodies):
     """Advance ``schedule.n_steps`` SDIRK2 steps in place; the contract of :mod:`ropesim.integrate.base`.
 
     ``state`` = (x, v, ledger, stats), ``stats[0]`` counting Newton iterations (force evaluations). Returns
@@ -320,7 +320,7 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
         done = step + 1
         if not due(done, schedule):
             continue  # nothing due: skip the call, whose array arguments cost more than a small rope's step
-        status, node, frame = end_step(done, schedule, x, v, mass, params, ledger, limits, frames, frame)
+        status, node, frame = end_step(done, schedule, x, v, mass, params, ledger, limits, frames, frame, bodies)
         if status != OK:
             return s + 1, frame, status, node
     return schedule.n_steps, frame, OK, -1

@@ -30,8 +30,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model import jit
+from ..model.bodies import WITH_BODIES, drift_bodies, place_attachments, save_bodies
 from ..model.terms import (WITH_APPLIED, WITH_GRAVITY, WITH_MOTION, WITH_VELOCITY_TERMS, accelerations,
-                           applied_accelerations, mechanical_energy, position_accelerations)
+                           applied_accelerations, bodies_energy, mechanical_energy, position_accelerations)
 from .base import Integrator, Method
 from .contact import exact_contact_kicks
 from .health import (BOX, DRAG, E0, FLUID, HELD, INTERNAL, OK, SCALE, SEABED, balance_status, flows, save_frame,
@@ -194,7 +195,7 @@ class Splitting(Integrator):
         self.general = General(np.zeros_like(self.x), model.smooth_contacts and model.applied,
                                np.ascontiguousarray(~model.held), np.where(model.held, 0.0, model.drag / model.mass),
                                np.zeros_like(self.x), np.zeros(model.nodes, dtype=np.int64), np.empty(model.nodes),
-                               velocity_scratch(*self.x.shape))
+                               velocity_scratch(*self.x.shape, self.pose.shape[1]))
         self.bundle = SplittingState(self.x, self.v, self.acc, self.have_acc, self.ledger, self.spring_forces,
                                      self.lost)
 
@@ -224,12 +225,13 @@ class Splitting(Integrator):
     def _run(self, n, frames):
         m = self.model
         return self.loop(self.bundle, self.kicks, self.plain, self.general, self.held, m.mass, m.params, self.limits,
-                         self.schedule(n), frames)
+                         self.schedule(n), frames, self.bodies)
 
 
 @jit.kernel
-def advance_splitting(state, kicks, plain, general, held, mass, params, limits, schedule, frames):
-    """Advance ``schedule.n_steps`` splitting steps in place, from global step ``schedule.step0``.
+def advance_splitting(state, kicks, plain, general, held, mass, params, limits, schedule, frames, bodies):
+    """Advance ``schedule.n_steps`` splitting steps in place, from global step ``schedule.step0``; ``bodies`` the
+    free rigid bodies' state (pose, twist), drifted with the nodes (q <- exp(c w) q) and kicked with them.
 
     The contract of :mod:`ropesim.integrate.base`; returns (steps done, frames written, status, node). Each
     kick stage is the plain stage (switch ``WITH_PLAIN_STAGE``: a 2-D rope with its springs and gravity alone; see
@@ -268,6 +270,9 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
             for d in range(dim):
                 for i in range(n):
                     x[d, i] += ch * v[d, i]
+            if WITH_BODIES:
+                drift_bodies(bodies.pose, bodies.twist, ch)
+                place_attachments(x, v, params.bodies, bodies.pose, bodies.twist)
             t += ch
             if WITH_MOTION:
                 place_moving(x, v, held, t, middle)
@@ -363,7 +368,7 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
                 position_accelerations(x, acc, params)
                 loss, supports, box, fluid, internal, seabed = velocity_kick(x, v, acc, kick[st] * h, t, params,
                                                                              mass, general.gamma, held,
-                                                                             general.vscratch)
+                                                                             general.vscratch, bodies)
                 ledger[DRAG] += loss
                 ledger[BOX] += box
                 ledger[FLUID] += fluid
@@ -374,6 +379,9 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
                     for d in range(dim):
                         for i in range(n):
                             x[d, i] += ch * v[d, i]
+                    if WITH_BODIES:
+                        drift_bodies(bodies.pose, bodies.twist, ch)
+                        place_attachments(x, v, params.bodies, bodies.pose, bodies.twist)
             else:
                 # ---- the general stage: every term through the term list, the kick and its ledger per node
                 if fresh:
@@ -434,6 +442,8 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
             energy, stretch, worst = chain_energy(x, v, mass, k_spring, rest, closed, g, plain.lengths, plain.terms)
         else:
             energy, stretch, worst = mechanical_energy(x, v, mass, params)
+        if WITH_BODIES:
+            energy += bodies_energy(params, bodies.pose, bodies.twist)
         flowed, moved = flows(ledger)
         status = balance_status(energy, stretch, flowed, moved, ledger[E0], ledger[SCALE], limits[0], limits[1],
                                 limits[2])
@@ -443,6 +453,8 @@ def advance_splitting(state, kicks, plain, general, held, mass, params, limits, 
                 return s + 1, frame, status, node
         if saving:
             save_frame(frame, done * h, x, v, ledger, frames.t, frames.x, frames.v, frames.ledger)
+            if WITH_BODIES:
+                save_bodies(frame, bodies.pose, bodies.twist, frames.body)
             frame += 1
     ledger[HELD] = held_work
     if WITH_PLAIN_STAGE:

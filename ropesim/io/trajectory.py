@@ -21,7 +21,8 @@ from .frames import check_run_folder, read_run
 from .runfolder import SCENE, TRAJECTORY, RunFolderError
 
 ARRAYS = ("t", "x", "v")
-DERIVED = ("tension", "strain", "support")   # per frame, derived from t, x and v as they are stored
+DERIVED = ("tension", "strain", "support", "body_x", "body_q", "body_v", "body_w")
+"""Per frame, derived from t, x and v (and the free bodies' states) as they are stored."""
 
 
 class FrameStore:
@@ -29,9 +30,9 @@ class FrameStore:
     them through :class:`ropesim.io.runfolder.RunWriter` instead).
 
     Named per-frame arrays: ``t``, ``x``, ``v``, ``ledger`` (the energy ledger's flows), and with ``derive`` (a
-    function of the frames' t (k,), x and v (k, N, D) returning named (k, ...) arrays, ``shapes`` their per-frame
-    shapes) what it derives: the segments' tension and strain, the supports' forces
-    (:mod:`ropesim.model.tension`).
+    function of the frames' t (k,), x and v (k, N, D) and the free bodies' states (k, 13, B) or None, returning
+    named (k, ...) arrays, ``shapes`` their per-frame shapes) what it derives: the segments' tension and strain,
+    the supports' forces, the rigid bodies' poses (:mod:`ropesim.model.tension`).
     """
 
     def __init__(self, n_frames: int, nodes: int, dim: int, folder: Path | None = None, derive=None,
@@ -53,22 +54,25 @@ class FrameStore:
             return arrays[name]
         raise AttributeError(name)
 
-    def rows(self, t: np.ndarray, x_dn: np.ndarray, v_dn: np.ndarray, ledger: np.ndarray | None) -> dict:
-        """Frames given in kernel layout (F, D, N), as the named per-frame arrays to store."""
+    def rows(self, t: np.ndarray, x_dn: np.ndarray, v_dn: np.ndarray, ledger: np.ndarray | None,
+             body: np.ndarray | None = None) -> dict:
+        """Frames given in kernel layout (F, D, N) (and the free rigid bodies' states (F, 13, B)), as the named
+        per-frame arrays to store."""
         x, v = np.swapaxes(x_dn, 1, 2), np.swapaxes(v_dn, 1, 2)
         out = {"t": np.asarray(t), "x": x, "v": v}
         if self.derive is not None:
-            out.update(self.derive(out["t"], x, v))
+            out.update(self.derive(out["t"], x, v, body))
         out["ledger"] = np.zeros((len(t), self.specs["ledger"][0])) if ledger is None else ledger
         return out
 
-    def append(self, t: np.ndarray, x_dn: np.ndarray, v_dn: np.ndarray, ledger: np.ndarray | None = None) -> None:
-        """Append frames given in kernel layout (F, D, N) (and their ledger rows)."""
+    def append(self, t: np.ndarray, x_dn: np.ndarray, v_dn: np.ndarray, ledger: np.ndarray | None = None,
+               body: np.ndarray | None = None) -> None:
+        """Append frames given in kernel layout (F, D, N) (and their ledger rows and bodies' states)."""
         k = len(t)
         if k == 0:
             return
         end = self.count + k
-        for name, values in self.rows(t, x_dn, v_dn, ledger).items():
+        for name, values in self.rows(t, x_dn, v_dn, ledger, body).items():
             self._arrays[name][self.count:end] = values
         self.count = end
 
@@ -97,6 +101,10 @@ class Trajectory:
     strain: np.ndarray | None = None
     support: np.ndarray | None = None
     ledger: np.ndarray | None = None   # (F, C) the energy ledger's cumulative flows [J], columns LEDGER_COLUMNS
+    body_x: np.ndarray | None = None   # (F, B, D) each rigid body's reference point [m] (None without bodies)
+    body_q: np.ndarray | None = None   # (F, B, 4) its orientation, a unit quaternion (w, x, y, z), body to world
+    body_v: np.ndarray | None = None   # (F, B, D) its reference point's velocity [m/s]
+    body_w: np.ndarray | None = None   # (F, B, 3) its angular velocity in world axes [rad/s]
 
     @property
     def frames(self) -> int:

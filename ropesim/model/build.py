@@ -19,8 +19,10 @@ import numpy as np
 
 from ..scene import schema as S
 from ..scene.shapes import initial_positions, sagging_line
+from .bodies import attachments, initial_pose, initial_state
 from .layout import LineLayout, line_layouts, lumped_bodies, node_lengths, point_ends
-from .motion import Motion, motion_of
+from .rotation import rotation_matrix
+from .motion import WITH_RIGID_MOTION, Motion, motion_of
 from . import jit
 from .terms import WITH_APPLIED, WITH_MOTION, WITH_VELOCITY_TERMS, Layout, ModelParams, model_params, switches
 
@@ -42,6 +44,8 @@ class Model:
     motion: Motion            # the held nodes' prescribed motion beyond x0 + V t (see model/motion.py)
     switches: jit.Switches    # the compile-time switches that are on: the scene's terms, prescribed motion
     lines: tuple[LineLayout, ...]   # each line's nodes and material (a rope: one line)
+    body_pose0: np.ndarray    # (7, B) the free rigid bodies' reference points and orientations at t = 0
+    body_twist0: np.ndarray   # (6, B) their velocities and angular velocities at t = 0 (model/bodies.py)
 
     @property
     def dim(self) -> int:
@@ -97,6 +101,7 @@ class Nodes:
     held_v: np.ndarray    # (D, N) the held nodes' constant velocities [m/s]
     held: np.ndarray      # (N,) bool
     drives: list          # (node indices, drive) of the held nodes' prescribed motions (model/motion.py)
+    rigid: list = ()      # (driven rigid body, [(node, arm (3,))]) of the nodes on driven bodies' points
 
 
 def build(scene: S.Scene, solve: bool = True) -> Model:
@@ -111,11 +116,14 @@ def build(scene: S.Scene, solve: bool = True) -> Model:
     v0[:, held_idx] = held_v[:, held_idx]
 
     layout = Layout(mass, held, node_lengths(lines, len(mass)), lines)
-    motion = motion_of(scene.dimension, held_idx, nodes.drives)
+    motion = motion_of(scene.dimension, held_idx, nodes.drives, nodes.rigid)
+    pose0, twist0 = initial_state(scene)
     model = Model(scene=scene, x0=x0, v0=v0, mass=mass, drag=nodes.drag, held=held, held_idx=held_idx,
                   held_x0=np.ascontiguousarray(x0[:, held_idx]), held_v=np.ascontiguousarray(held_v[:, held_idx]),
                   params=model_params(scene, layout), motion=motion,
-                  switches=switches(scene) | ({WITH_MOTION.name} if motion.moving else set()), lines=lines)
+                  switches=switches(scene) | ({WITH_MOTION.name} if motion.moving else set())
+                  | ({WITH_RIGID_MOTION.name} if nodes.rigid else set()), lines=lines,
+                  body_pose0=pose0, body_twist0=twist0)
     if solve and isinstance(scene.initial, (S.EquilibriumStart, S.SystemEquilibriumStart)):
         from .statics import solve_equilibrium
 
@@ -178,14 +186,20 @@ def _system_nodes(scene: S.Scene, lines) -> Nodes:
         mass[part] = line.mass_per_length * layout.segment_length
         mass[[layout.first, layout.end - 1]] *= 0.5
     held, held_v, drives = np.zeros(n, dtype=bool), np.zeros((dim, n)), []
-    for point_id, ends in point_ends(scene, lines).items():
+    ends = point_ends(scene, lines)
+    for point_id, on_point in ends.items():
         point = points[point_id]
-        if point.kind in ("fixed", "driven") and ends:
-            held[ends] = True
-        if point.kind == "driven" and ends:
-            held_v[:, ends] = np.asarray(point.velocity)[:, None]
-            drives.append((ends, point))
-    return Nodes(x0, v0, mass, np.zeros(n), held_v, held, drives)
+        if point.kind in ("fixed", "driven") and on_point:
+            held[on_point] = True
+        if point.kind == "driven" and on_point:
+            held_v[:, on_point] = np.asarray(point.velocity)[:, None]
+            drives.append((on_point, point))
+    on_bodies = attachments(scene, ends)
+    rigid = [(body, on_bodies[body.id]) for body in scene.rigid_bodies if body.kind == "driven"]
+    for body in scene.rigid_bodies:
+        if body.kind != "free":
+            held[[node for node, _ in on_bodies[body.id]]] = True
+    return Nodes(x0, v0, mass, np.zeros(n), held_v, held, drives, rigid)
 
 
 def point_position(scene: S.Scene, point: S.Point) -> tuple:
@@ -193,7 +207,12 @@ def point_position(scene: S.Scene, point: S.Point) -> tuple:
     by the body's orientation)."""
     if point.kind != "body":
         return point.position
-    raise NotImplementedError("points on rigid bodies come with rigid bodies")
+    dim = scene.dimension
+    body = next(b for b in scene.rigid_bodies if b.id == point.body)
+    pose = initial_pose(body, dim)
+    arm = np.zeros(3)
+    arm[:dim] = point.position
+    return tuple((pose[:3] + rotation_matrix(pose[3:]) @ arm)[:dim])
 
 
 class EquilibriumError(ValueError):

@@ -22,6 +22,15 @@ Parameters (per held node j, axis d): ``base`` (D, H) the constant velocity V; `
 (D, H) the sinusoid A sin(omega t + phase) - A sin(phase); ``ramp`` (H,) the ramp time; ``path_t`` (K,) and
 ``path_d`` (D, K) every path's rows, concatenated, and ``span`` (H, 2) the rows of node j's path (empty if
 none); ``accel`` (D, H) written by :func:`place_moving`.
+
+A driven rigid body moves its points rigidly (switch :data:`WITH_RIGID_MOTION`): its six degrees of freedom
+(three in 2-D) follow the same law, q_k(t) = q_k(0) + V_k t + r(t) [sinusoid_k(t) + path_k(t)], the
+translations of its reference point r and its orientation angles (about x, then y, then z: R = Rz Ry Rx; about z
+in 2-D), and a held node j on it (``rigid[j]`` = the body, ``arm[:, j]`` its point in the body frame) sits at
+r + R arm, with velocity r' + w x rho and acceleration r'' + alpha x rho + w x (w x rho), rho = R arm, w and
+alpha the angular velocity and acceleration of the angles' rates (:func:`rigid_state`). ``bodies`` holds each
+driven body's motion as a :class:`Motion` over its six rows (x, y, z, then the angles about x, y, z [rad]), whose
+``accel`` holds its pose at t = 0 (the reference point, then the angles).
 """
 
 from __future__ import annotations
@@ -33,14 +42,18 @@ import numpy as np
 
 from . import jit
 
-Motion = namedtuple("Motion", ["moving", "base", "amp", "omega", "phase", "ramp", "path_t", "path_d", "span", "accel"])
+Motion = namedtuple("Motion", ["moving", "base", "amp", "omega", "phase", "ramp", "path_t", "path_d", "span", "accel",
+                               "rigid", "arm", "bodies"])
+
+WITH_RIGID_MOTION = jit.Switch("rigid_motion", "a driven rigid body moving its points")
 
 
-def motion_of(dim: int, held_idx: np.ndarray, drives) -> Motion:
+def motion_of(dim: int, held_idx: np.ndarray, drives, rigid=()) -> Motion:
     """The held nodes' prescribed motion (all zero and ``moving`` False for pins and constant drives).
 
     ``drives``: (nodes, drive) pairs, the node indices a drive moves and its motion (velocity, amplitude,
-    period, phase, path_table, ramp_time: a rope's ``[[driven]]`` entry or a system's driven point)."""
+    period, phase, path_table, ramp_time: a rope's ``[[driven]]`` entry or a system's driven point); ``rigid``:
+    (driven rigid body, [(node, arm (3,))]) pairs, each body's motion and the nodes on its points."""
     h = len(held_idx)
     base, amp, omega, phase = (np.zeros((dim, h)) for _ in range(4))
     ramp, span = np.zeros(h), np.zeros((h, 2), dtype=np.int64)
@@ -62,9 +75,47 @@ def motion_of(dim: int, held_idx: np.ndarray, drives) -> Motion:
                 phase[:, j] = np.radians(drive.phase)
             span[j] = (first, len(times))
     path_d = np.asarray(rows, dtype=float).T.copy() if rows else np.zeros((dim, 0))
-    moving = any(drive.moving for _, drive in drives)
+    moving = any(drive.moving for _, drive in drives) or bool(rigid)
+    body_of, arm = np.full(h, -1, dtype=np.int64), np.zeros((3, h))
+    for b, (_, nodes) in enumerate(rigid):
+        for node, node_arm in nodes:
+            body_of[where[int(node)]] = b
+            arm[:, where[int(node)]] = node_arm
     return Motion(moving, base, amp, omega, phase, ramp, np.asarray(times, dtype=float), path_d, span,
-                  np.zeros((dim, h)))
+                  np.zeros((dim, h)), body_of, arm, _body_motions(dim, [body for body, _ in rigid]))
+
+
+def _body_motions(dim: int, bodies) -> Motion:
+    """The driven bodies' motions over their six rows (see the module doc); empty without any."""
+    count = len(bodies)
+    rows = [0, 1, 2, 3, 4, 5] if dim == 3 else [0, 1, 5]   # each degree of freedom's row
+    base, amp, omega, phase = (np.zeros((6, count)) for _ in range(4))
+    ramp, span, pose0 = np.zeros(count), np.zeros((count, 2), dtype=np.int64), np.zeros((6, count))
+    times, path = [], []
+    for b, body in enumerate(bodies):
+        turns = len(rows) - dim
+        pose0[:dim, b] = body.position
+        pose0[[r for r in rows[dim:]], b] = np.radians(body.orientation)
+        base[rows[:dim], b] = body.velocity
+        base[rows[dim:], b] = np.radians(body.angular_velocity)
+        ramp[b] = body.ramp_time
+        scale = np.array([1.0] * dim + [math.pi / 180.0] * turns)   # angles in degrees
+        if body.amplitude is not None:
+            amp[rows, b] = np.asarray(body.amplitude) * scale
+            omega[rows, b] = [2.0 * math.pi / T if a != 0.0 else 0.0 for a, T in zip(body.amplitude, body.period)]
+            phase[rows, b] = np.radians(body.phase)
+        first = len(times)
+        if body.path_table is not None:
+            table = np.asarray(body.path_table, dtype=float)
+            times.extend(table[:, 0])
+            for row in table[:, 1:]:
+                full = np.zeros(6)
+                full[rows] = row * scale
+                path.append(full)
+        span[b] = (first, len(times))
+    path_d = np.asarray(path, dtype=float).T.copy() if path else np.zeros((6, 0))
+    return Motion(bool(count), base, amp, omega, phase, ramp, np.asarray(times, dtype=float), path_d, span, pose0,
+                  np.zeros(0, dtype=np.int64), np.zeros((3, 0)), None)
 
 
 @jit.kernel(inline="always")
@@ -112,6 +163,68 @@ def offset(m, j, d, t, t_piece):
     return r * s, dr * s + r * ds, ddr * s + 2.0 * dr * ds + r * dds
 
 
+@jit.kernel(inline="always")
+def _dof(bodies, b, d, t, t_piece):
+    """(value, rate, acceleration) of driven body b's row d at time t."""
+    s, ds, dds = offset(bodies, b, d, t, t_piece)
+    return bodies.accel[d, b] + bodies.base[d, b] * t + s, bodies.base[d, b] + ds, dds
+
+
+@jit.kernel
+def rigid_state(bodies, b, t, t_piece):
+    """Driven body b's pose and motion at time t (a path on the piece that holds ``t_piece``): its reference
+    point, velocity and acceleration (3 each, world), its rotation matrix (9, row by row), angular velocity and
+    angular acceleration (3 each, world), as one tuple of 24 numbers."""
+    x0, dx0, ddx0 = _dof(bodies, b, 0, t, t_piece)
+    x1, dx1, ddx1 = _dof(bodies, b, 1, t, t_piece)
+    x2, dx2, ddx2 = _dof(bodies, b, 2, t, t_piece)
+    a, da, dda = _dof(bodies, b, 3, t, t_piece)    # about x
+    bb, db, ddb = _dof(bodies, b, 4, t, t_piece)   # about y
+    c, dc, ddc = _dof(bodies, b, 5, t, t_piece)    # about z
+    ca, sa, cb, sb, cc, sc = math.cos(a), math.sin(a), math.cos(bb), math.sin(bb), math.cos(c), math.sin(c)
+    # R = Rz(c) Ry(b) Rx(a)
+    r00, r01, r02 = cc * cb, cc * sb * sa - sc * ca, cc * sb * ca + sc * sa
+    r10, r11, r12 = sc * cb, sc * sb * sa + cc * ca, sc * sb * ca - cc * sa
+    r20, r21, r22 = -sb, cb * sa, cb * ca
+    # w = c' e_z + b' u2 + a' u3, u2 = Rz e_y, u3 = Rz Ry e_x
+    u20, u21 = -sc, cc
+    u30, u31, u32 = cc * cb, sc * cb, -sb
+    w0 = db * u20 + da * u30
+    w1 = db * u21 + da * u31
+    w2 = dc + da * u32
+    # alpha = c'' e_z + b'' u2 + a'' u3 + b' (c' e_z x u2) + a' ((c' e_z + b' u2) x u3)
+    o0, o1, o2 = db * u20, db * u21, dc   # c' e_z + b' u2
+    al0 = ddb * u20 + dda * u30 + db * (-dc * u21) + da * (o1 * u32 - o2 * u31)
+    al1 = ddb * u21 + dda * u31 + db * (dc * u20) + da * (o2 * u30 - o0 * u32)
+    al2 = ddc + dda * u32 + da * (o0 * u31 - o1 * u30)
+    return (x0, x1, x2, dx0, dx1, dx2, ddx0, ddx1, ddx2,
+            r00, r01, r02, r10, r11, r12, r20, r21, r22, w0, w1, w2, al0, al1, al2)
+
+
+@jit.kernel
+def place_rigid(x, v, held, j, t, t_piece):
+    """Put held node j, on a driven rigid body, where its body's motion puts it at time t (see the module doc)."""
+    idx, _, hv, m = held
+    i = idx[j]
+    dim = x.shape[0]
+    (r0, r1, r2, v0, v1, v2, a0, a1, a2, r00, r01, r02, r10, r11, r12, r20, r21, r22, w0, w1, w2, al0, al1,
+     al2) = rigid_state(m.bodies, m.rigid[j], t, t_piece)
+    s0, s1, s2 = m.arm[0, j], m.arm[1, j], m.arm[2, j]
+    p0 = r00 * s0 + r01 * s1 + r02 * s2
+    p1 = r10 * s0 + r11 * s1 + r12 * s2
+    p2 = r20 * s0 + r21 * s1 + r22 * s2
+    e0, e1, e2 = w1 * p2 - w2 * p1, w2 * p0 - w0 * p2, w0 * p1 - w1 * p0   # w x rho
+    pos = (r0 + p0, r1 + p1, r2 + p2)
+    vel = (v0 + e0, v1 + e1, v2 + e2)
+    acc = (a0 + al1 * p2 - al2 * p1 + w1 * e2 - w2 * e1, a1 + al2 * p0 - al0 * p2 + w2 * e0 - w0 * e2,
+           a2 + al0 * p1 - al1 * p0 + w0 * e1 - w1 * e0)
+    for d in range(dim):
+        x[d, i] = pos[d]
+        hv[d, j] = vel[d]
+        v[d, i] = vel[d]
+        m.accel[d, j] = acc[d]
+
+
 @jit.kernel
 def place_moving(x, v, held, t, t_piece):
     """Put every held node at its prescribed place at time t, set its velocity in ``v`` and in ``held.v``,
@@ -121,6 +234,9 @@ def place_moving(x, v, held, t, t_piece):
     dim = x.shape[0]
     for j in range(idx.shape[0]):
         i = idx[j]
+        if WITH_RIGID_MOTION and m.rigid[j] >= 0:
+            place_rigid(x, v, held, j, t, t_piece)
+            continue
         for d in range(dim):
             s, ds, dds = offset(m, j, d, t, t_piece)
             x[d, i] = x0[d, j] + m.base[d, j] * t + s

@@ -13,9 +13,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .bodies import body_frames, body_shapes
 from .forces.fluid import flow_at
 from .forces.springs import segment_forces, segment_strains
-from .motion import offset
+from .motion import place_moving
 from .terms import accelerations
 
 
@@ -38,15 +39,20 @@ def frame_shapes(model) -> dict[str, tuple]:
     shapes = {"tension": (segment_count(model),), "strain": (segment_count(model),)}
     if model.held_idx.size:
         shapes["support"] = (model.held_idx.size, model.dim)
+    shapes.update(body_shapes(model))
     return shapes
 
 
-def frame_arrays(model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> dict[str, np.ndarray]:
-    """{"tension": (F, S) [N], "strain": (F, S) [-], "support": (F, H, D) [N] if any node is held} for frames
-    at times t (F,) with positions and velocities x, v (F, N, D)."""
+def frame_arrays(model, t: np.ndarray, x: np.ndarray, v: np.ndarray, body: np.ndarray | None = None
+                 ) -> dict[str, np.ndarray]:
+    """{"tension": (F, S) [N], "strain": (F, S) [-], "support": (F, H, D) [N] if any node is held, and with rigid
+    bodies their poses (:func:`ropesim.model.bodies.body_frames`)} for frames at times t (F,) with positions and
+    velocities x, v (F, N, D) and the free bodies' states ``body`` (F, 13, B)."""
     out = {"tension": segment_forces(model, x, v), "strain": segment_strains(model, x)}
     if model.held_idx.size:
         out["support"] = support_forces(model, t, x, v)
+    if model.scene.rigid_bodies:
+        out.update(body_frames(model, t, body))
     return out
 
 
@@ -57,14 +63,16 @@ def support_forces(model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> np.nda
     acc = np.zeros((model.dim, model.nodes))
     out = np.zeros((len(t), idx.size, model.dim))
     forces = model.kernel(accelerations)
+    if m.moving:   # the prescribed accelerations a_p, as the loops compute them
+        held = (idx, model.held_x0, model.held_v.copy(), m._replace(accel=np.zeros_like(m.accel)))
+        prescribed = model.kernel(place_moving)
     for k in range(len(t)):
         xk, vk = np.ascontiguousarray(np.asarray(x[k]).T), np.ascontiguousarray(np.asarray(v[k]).T)
         forces(xk, vk, acc, model.params, float(t[k]))
         out[k] = -(mass * acc[:, idx].T + held_linear_drag(model, float(t[k]), xk, vk))
         if m.moving:
-            for j in range(idx.size):
-                for d in range(model.dim):
-                    out[k, j, d] += mass[j, 0] * offset(m, j, d, float(t[k]), float(t[k]))[2]
+            prescribed(xk.copy(), vk.copy(), held, float(t[k]), float(t[k]))
+            out[k] += mass * held[3].accel.T
     return out
 
 

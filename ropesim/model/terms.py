@@ -55,7 +55,8 @@ from .forces.thrower import WITH_THROWER, add_thrower, add_thrower_jacobian
 from .banded import WITH_WRAP_AROUND
 from .forces.fluid import neighbours
 from .junctions import WITH_JUNCTIONS, junction_bundle, move_junctions, no_junctions
-from .layout import junctions, line_layouts, line_table
+from .bodies import WITH_BODIES, bodies_bundle, body_energy, free_bodies, move_bodies, no_bodies
+from .layout import junctions, line_layouts, line_table, point_ends
 from .jacobian import pair_damper_blocks, pair_spring_blocks
 from . import jit
 
@@ -69,14 +70,15 @@ WITH_APPLIED = jit.Switch("applied", "a term whose work the ledger books as box_
 WITH_MOTION = jit.Switch("motion", "a held node with a prescribed motion beyond x0 + V t")
 
 ModelParams = namedtuple("ModelParams", [
-    "inv_mass", "node_length", "lines", "neighbours", "junctions", "spring", "bending", "gravity", "buoyancy",
+    "inv_mass", "node_length", "lines", "neighbours", "junctions", "bodies", "spring", "bending", "gravity", "buoyancy",
     "thrower", "guides", "axial", "fluid_drag", "viscous_drag", "body_drag", "flow", "flow_push", "added_mass",
     "seabed", "bending_ei", "flow_inertia"])
 """What the compiled code knows of the model's forces: 1 / m per node (N,), each node's share of unstretched
 length (N,) [m], the lines' nodes (L, 2) (first, one past the last: :func:`ropesim.model.layout.line_table`),
 the nodes whose chord gives each node's tangent (2, N) (:func:`ropesim.model.forces.fluid.neighbours`), a
-system's free points (:class:`ropesim.model.junctions.Junctions`), and each term's parameters, in TERMS order
-(see each term's module for its layout)."""
+system's free points (:class:`ropesim.model.junctions.Junctions`) and free rigid bodies
+(:class:`ropesim.model.bodies.Bodies`), and each term's parameters, in TERMS order (see each term's module for
+its layout)."""
 
 Layout = namedtuple("Layout", ["mass", "held", "node_length", "lines"])
 """What a term's ``params`` builder gets besides the scene: per-node mass [kg], held (bool) and length [m], and
@@ -90,9 +92,12 @@ def model_params(scene, layout: Layout) -> ModelParams:
     around = np.tile(np.arange(n, dtype=np.int64), (2, 1))   # a node on no line: its own neighbour, no tangent
     for line in layout.lines:
         around[:, line.first:line.end] = neighbours(line.first, line.nodes, line.closed)
+    added = values[TERMS.index(ADDED_MASS_TERM)]
     groups = junctions(scene, layout.lines)
-    points = junction_bundle(groups, values[TERMS.index(ADDED_MASS_TERM)]) if groups else no_junctions()
-    return ModelParams(1.0 / layout.mass, layout.node_length, line_table(layout.lines), around, points, *values)
+    points = junction_bundle(groups, added) if groups else no_junctions()
+    bodies = bodies_bundle(scene, point_ends(scene, layout.lines), added) if free_bodies(scene) else no_bodies()
+    return ModelParams(1.0 / layout.mass, layout.node_length, line_table(layout.lines), around, points, bodies,
+                       *values)
 
 
 def declared_terms(scene) -> tuple:
@@ -110,8 +115,10 @@ def switches(scene) -> jit.Switches:
         on.add(WITH_WRAP_AROUND.name)
     if junctions(scene):
         on.add(WITH_JUNCTIONS.name)
-    if any(term.velocity for term in declared) or junctions(scene):   # a junction's kick solves for its point
-        on.add(WITH_VELOCITY_TERMS.name)
+    if free_bodies(scene):
+        on.add(WITH_BODIES.name)
+    if any(term.velocity for term in declared) or junctions(scene) or free_bodies(scene):
+        on.add(WITH_VELOCITY_TERMS.name)   # a junction's or a body's kick solves for its point or body
     if any(term.ledger == "box" for term in declared):
         on.add(WITH_APPLIED.name)
     return frozenset(on)
@@ -189,6 +196,21 @@ def solve_accelerations(x, v, acc, p):
     if WITH_JUNCTIONS:
         power += move_junctions(x, v, acc, p.inv_mass, p.junctions, p.neighbours)
     return power
+
+
+@jit.kernel(inline="always")
+def body_accelerations(x, v, acc, p, pose, twist, out, t):
+    """The free bodies' accelerations into ``out`` (6, B) and their attachments' into ``acc``, from ``acc`` holding
+    every force / m (:func:`ropesim.model.bodies.move_bodies`), the bodies at ``pose``, ``twist`` at time t [s];
+    returns the power [W] of the fluid's forces on the bodies. Called after :func:`solve_accelerations`."""
+    g = p.gravity[0] if WITH_GRAVITY else 0.0
+    return move_bodies(x, v, acc, p.inv_mass, p.neighbours, g, p.flow, p.bodies, pose, twist, out, t)
+
+
+@jit.kernel(inline="always")
+def bodies_energy(p, pose, twist):
+    """The free bodies' kinetic, gravitational and buoyancy energy [J] (:func:`ropesim.model.bodies.body_energy`)."""
+    return body_energy(p.bodies, pose, twist, p.gravity[0] if WITH_GRAVITY else 0.0)
 
 
 @jit.kernel

@@ -440,9 +440,10 @@ class RigidBody:
                                     required=False)
     added_inertia: tuple | None = spec("angles", "added moment of inertia about each body axis", "kg m^2",
                                        default=None, required=False)
-    velocity: tuple | None = spec("vector", "driven: constant velocity of the reference point", "m/s",
-                                  default=None, required=False)
-    angular_velocity: tuple | None = spec("angles", "driven: constant rotation rate", "deg/s", default=None,
+    velocity: tuple | None = spec("vector", "driven: constant velocity of the reference point; free: its velocity "
+                                            "at t = 0", "m/s", default=None, required=False)
+    angular_velocity: tuple | None = spec("angles", "driven: constant rotation rate about x, y, z (world axes); free: "
+                                                    "its rotation rate at t = 0", "deg/s", default=None,
                                           required=False)
     amplitude: tuple | None = spec("dofs", "driven: sinusoid amplitude per degree of freedom (translations, then "
                                            "rotations)", "m, deg", default=None, required=False)

@@ -189,8 +189,12 @@ def _resolve_body(scene: S.Scene, j: int, body: S.RigidBody, base_dir: Path, fai
         if body.inertia is None:
             fail(f"{key}.inertia", "missing: a free body needs its moments of inertia about its centre of gravity "
                                    f"[kg m^2] ({'Ixx, Iyy, Izz' if dim == 3 else 'Izz'})")
+    if body.kind == "free":   # its velocities at t = 0, at rest unless given
+        body = replace(body, velocity=body.velocity if body.velocity is not None else zeros,
+                       angular_velocity=body.angular_velocity if body.angular_velocity is not None else turns)
     if body.kind != "driven":
-        given = [k for k in (*BODY_MOTION_KEYS, "ramp_time") if getattr(body, k) is not None]
+        starts = ("velocity", "angular_velocity") if body.kind == "free" else ()
+        given = [k for k in (*BODY_MOTION_KEYS, "ramp_time") if getattr(body, k) is not None and k not in starts]
         if given:
             fail(f"{key}.{given[0]}", f"is a driven body's motion; this body is '{body.kind}' (set kind = 'driven' "
                                       f"to move it so)")

@@ -1,0 +1,531 @@
+"""Free rigid bodies: a spar, a buoy, a container moving in 6 degrees of freedom (3 in 2-D) under its lines.
+
+State, per free body b (world frame, SI units): ``pose`` (7, B) its reference point r (3) and orientation q (4, a
+unit quaternion, body frame to world, :mod:`ropesim.model.rotation`); ``twist`` (6, B) the velocity of the
+reference point v and the angular velocity w, in world axes. Not nodes: the integrators carry it beside x and v.
+
+Line ends on a body's points (its *attachments*) are line nodes slaved to the body: node i at arm s_i (body
+frame) sits at x_i = r + R s_i and moves at v_i = v + w x rho_i, rho_i = R s_i (:func:`place_attachments`, called
+whenever the body's state changes). The forces of every term on an attachment node (F_i = m_i acc_i, its springs,
+weight, drag, ...) act on the body, and the node's mass m_i and added mass A_i (its line's, along the node's
+tangent) join the body's; so the node keeps its line's lumping, and the body takes what the node carries, as
+MoorDyn's body takes its points' net forces and masses (``Point::getNetForceAndMass``).
+
+Newton-Euler about the reference point, in world axes, with a and alpha the reference point's and the body's
+accelerations (:func:`move_bodies`):
+
+    sum over masses mu (the body's own m at its centre of gravity c = R c_b, each attachment's m_i I + A_i at rho_i):
+        mu a - mu [rho]x alpha                = F_rho - mu w x (w x rho)
+        [rho]x mu a - [rho]x mu [rho]x alpha  = rho x (F_rho - mu w x (w x rho))
+    plus the body's inertia about its centre of gravity I = R I_b R^T: I alpha + w x (I w) on the moment's side,
+    and its own added mass A_t = R diag(a_b) R^T (on a) and added inertia A_r = R diag(j_b) R^T (on alpha).
+
+The body's own forces: its weight -m g y at c; buoyancy rho V g y at its centre of buoyancy R c_B; drag on the
+velocity u = U(r) - v of the flow relative to the reference point, F = 1/2 rho R diag(CdA) R^T u |u|, and the
+rotational drag moment -1/2 rho R diag(Cd_r) R^T w |w| (MoorDyn's body drag, ``Body::doRHS``). The added mass
+acts on the accelerations alone: the velocity-dependent forces of potential flow on a body (the Munk moment) are
+left out, as MoorDyn leaves them out. The 6 x 6 matrix is symmetric positive definite (a body's own mass or inertia
+may be zero when its attachments carry it); in 2-D the body moves in x, y and turns about z, and the solve keeps
+those three degrees of freedom.
+
+The power of the fluid's forces on the body (drag, and the added mass's inertial force -A a) is booked as fluid
+work, as for a node. Gravity and buoyancy are conservative: the body's mechanical energy is
+1/2 m |v + w x c|^2 + 1/2 w . I w + m g (r + c)_y - rho V g (r + R c_B)_y (:func:`body_energy`).
+
+Parameters, :class:`Bodies` (B free bodies, K attachments): per body mass (B,) [kg], centre of gravity ``cog``
+(3, B) and of buoyancy ``cob`` (3, B) in the body frame [m], ``inertia`` (3, 3, B) about the centre of gravity in
+body axes [kg m^2], ``lift`` (B,) rho V g [N], ``drag`` (3, B) 1/2 rho CdA [kg/m], ``drag_rot`` (3, B) 1/2 rho Cd_r
+[kg m^2], ``added`` (3, B) [kg] and ``added_rot`` (3, B) [kg m^2] on the body axes; body b's attachments are
+``nodes[start[b]:start[b + 1]]`` at arms ``arm`` (3, K) [m], with their line added-mass coefficients
+``node_added`` (2, K) [kg] (a_n, a_t: the per-node added-mass pass leaves them to this one); ``work`` (6, 7) is
+the solve's scratch.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+
+from . import jit
+from .forces.fluid import WITH_FLOW, flow_at, node_tangent
+from .rotation import cross, matrix_of, quaternion_from_angles, rotate, rotate_back, turn
+
+WITH_BODIES = jit.Switch("bodies", "free rigid bodies")
+
+Bodies = namedtuple("Bodies", ["mass", "cog", "inertia", "lift", "cob", "drag", "drag_rot", "added", "added_rot",
+                               "start", "nodes", "arm", "node_added", "work"])
+
+POSE, TWIST = 7, 6   # rows of the pose (r, q) and twist (v, w) arrays
+STATE_ROWS = POSE + TWIST   # a saved frame's rows per body
+
+
+def free_bodies(scene) -> tuple:
+    """The scene's free rigid bodies, in scene order (fixed and driven bodies hold their points instead)."""
+    return tuple(b for b in scene.rigid_bodies if b.kind == "free")
+
+
+def body_of_points(scene) -> dict[str, str]:
+    """Each point on a rigid body: point id -> body id."""
+    return {p.id: p.body for p in scene.points if p.kind == "body"}
+
+
+def attachments(scene, ends: dict[str, list[int]]) -> dict[str, list[tuple[int, np.ndarray]]]:
+    """Each rigid body's line end nodes and their arms in the body frame (3,) [m], by body id, from the line ends
+    on each point (:func:`ropesim.model.layout.point_ends`)."""
+    out: dict[str, list] = {b.id: [] for b in scene.rigid_bodies}
+    for point in scene.points:
+        if point.kind == "body":
+            arm = np.zeros(3)
+            arm[:scene.dimension] = point.position
+            out[point.body].extend((node, arm) for node in ends[point.id])
+    return out
+
+
+def vector3(values, dim: int) -> np.ndarray:
+    """A scene vector (dim,) as (3,) (0 along z in 2-D)."""
+    out = np.zeros(3)
+    out[:dim] = values
+    return out
+
+
+def turns3(values, dim: int) -> np.ndarray:
+    """A scene's per-rotation-axis values (3 in 3-D, about z alone in 2-D) as (3,)."""
+    out = np.zeros(3)
+    if dim == 2:
+        out[2] = values[0]
+    else:
+        out[:] = values
+    return out
+
+
+def inertia_tensor(values, dim: int) -> np.ndarray:
+    """The inertia (3, 3) [kg m^2] of a scene's moments: Ixx Iyy Izz [Ixy Ixz Iyz] in 3-D, Izz in 2-D (whose x and
+    y moments, which a planar motion never uses, are set to Izz to keep the tensor invertible)."""
+    if dim == 2:
+        return np.eye(3) * values[0]
+    ixx, iyy, izz = values[:3]
+    ixy, ixz, iyz = values[3:] if len(values) == 6 else (0.0, 0.0, 0.0)
+    return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]], dtype=float)
+
+
+def initial_pose(body, dim: int) -> np.ndarray:
+    """A body's pose (7,) at t = 0: its reference point and orientation."""
+    return np.concatenate([vector3(body.position, dim), quaternion_from_angles(body.orientation, dim)])
+
+
+def bodies_bundle(scene, ends: dict[str, list[int]], added: np.ndarray) -> Bodies:
+    """The compiled description of the scene's free bodies (see the module doc); their attachments' added-mass
+    coefficients are taken out of ``added`` (2, N), which the per-node pass then skips."""
+    dim = scene.dimension
+    bodies = free_bodies(scene)
+    rho = scene.fluid.density if scene.fluid is not None else 0.0
+    g = scene.gravity.g if scene.gravity is not None else 0.0
+    count = len(bodies)
+    out = {name: np.zeros((3, count)) for name in ("cog", "cob", "drag", "drag_rot", "added", "added_rot")}
+    mass, lift, inertia = np.zeros(count), np.zeros(count), np.zeros((3, 3, count))
+    start, nodes, arms = np.zeros(count + 1, dtype=np.int64), [], []
+    on_body = attachments(scene, ends)
+    for b, body in enumerate(bodies):
+        mass[b] = body.mass
+        lift[b] = rho * body.volume * g
+        inertia[:, :, b] = inertia_tensor(body.inertia, dim)
+        out["cog"][:, b] = vector3(body.center_of_gravity, dim)
+        out["cob"][:, b] = vector3(body.center_of_buoyancy, dim)
+        out["drag"][:, b] = 0.5 * rho * vector3(body.cd_area, dim)
+        out["drag_rot"][:, b] = 0.5 * rho * turns3(body.cd_rotation, dim)
+        out["added"][:, b] = vector3(body.added_mass, dim)
+        out["added_rot"][:, b] = turns3(body.added_inertia, dim)
+        for node, arm in on_body[body.id]:
+            nodes.append(node)
+            arms.append(arm)
+        start[b + 1] = len(nodes)
+    node_index = np.array(nodes, dtype=np.int64)
+    node_added = np.zeros((2, len(nodes)))
+    if added.size and len(nodes):
+        node_added[:] = added[:, node_index]
+        added[:, node_index] = 0.0
+    arm = np.array(arms, dtype=float).T.copy() if arms else np.zeros((3, 0))
+    return Bodies(mass, out["cog"], inertia, lift, out["cob"], out["drag"], out["drag_rot"], out["added"],
+                  out["added_rot"], start, node_index, arm, node_added, np.zeros((6, 7)))
+
+
+def no_bodies() -> Bodies:
+    """The empty bundle (a rope; a system without free bodies)."""
+    z3 = np.zeros((3, 0))
+    return Bodies(np.zeros(0), z3, np.zeros((3, 3, 0)), np.zeros(0), z3, z3, z3, z3, z3, np.zeros(1, dtype=np.int64),
+                  np.zeros(0, dtype=np.int64), z3, np.zeros((2, 0)), np.zeros((6, 7)))
+
+
+def body_energy_numpy(bundle: Bodies, pose: np.ndarray, twist: np.ndarray, g: float) -> dict[str, np.ndarray]:
+    """The free bodies' kinetic, gravitational and buoyancy energy [J] for poses (..., 7, B) and twists
+    (..., 6, B), as :func:`body_energy` computes it compiled (see the module doc)."""
+    from .rotation import rotation_matrix
+
+    pose, twist = np.asarray(pose), np.asarray(twist)
+    rot = rotation_matrix(np.moveaxis(pose[..., 3:7, :], -2, -1))            # (..., B, 3, 3)
+    c = np.einsum("...bij,jb->...bi", rot, bundle.cog)
+    cb = np.einsum("...bij,jb->...bi", rot, bundle.cob)
+    w = np.moveaxis(twist[..., 3:6, :], -2, -1)                               # (..., B, 3)
+    v_g = np.moveaxis(twist[..., 0:3, :], -2, -1) + np.cross(w, c)
+    inertia = np.einsum("...bij,jkb,...blk->...bil", rot, bundle.inertia, rot)
+    kinetic = 0.5 * (bundle.mass * np.einsum("...bi,...bi->...b", v_g, v_g)
+                     + np.einsum("...bi,...bij,...bj->...b", w, inertia, w))
+    y = pose[..., 1, :]
+    return {"body kinetic": kinetic.sum(axis=-1),
+            "body gravity": (bundle.mass * g * (y + c[..., 1])).sum(axis=-1),
+            "body buoyancy": (-bundle.lift * (y + cb[..., 1])).sum(axis=-1)}
+
+
+# ------------------------------------------------------------------------------------------ compiled
+
+
+@jit.kernel
+def place_attachments(x, v, bodies, pose, twist):
+    """Put every attachment node where its body holds it: x_i = r + R s_i, v_i = v + w x R s_i."""
+    dim = x.shape[0]
+    start, nodes, arm = bodies.start, bodies.nodes, bodies.arm
+    for b in range(start.shape[0] - 1):
+        r = matrix_of(pose[3:7], b)
+        w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
+        for k in range(start[b], start[b + 1]):
+            i = nodes[k]
+            p0, p1, p2 = rotate(r, arm[0, k], arm[1, k], arm[2, k])
+            e0, e1, e2 = cross(w0, w1, w2, p0, p1, p2)
+            x[0, i] = pose[0, b] + p0
+            x[1, i] = pose[1, b] + p1
+            v[0, i] = twist[0, b] + e0
+            v[1, i] = twist[1, b] + e1
+            if dim == 3:
+                x[2, i] = pose[2, b] + p2
+                v[2, i] = twist[2, b] + e2
+
+
+@jit.kernel
+def drift_bodies(pose, twist, c):
+    """Move every body for a time c [s] at its current velocities: r += c v, q <- exp(c w) q (exact for a constant
+    twist: the splitting schemes' drift)."""
+    for b in range(pose.shape[1]):
+        for d in range(3):
+            pose[d, b] += c * twist[d, b]
+        turn(pose[3:7], b, c * twist[3, b], c * twist[4, b], c * twist[5, b])
+
+
+@jit.kernel(inline="always")
+def _add_mass_at(work, m00, m01, m02, m11, m12, m22, p0, p1, p2):
+    """Add a mass matrix M (symmetric, its six entries) sitting at arm p from the reference point to the 6 x 6
+    matrix in ``work``: [[M, -M [p]x], [[p]x M, -[p]x M [p]x]]."""
+    mm = ((m00, m01, m02), (m01, m11, m12), (m02, m12, m22))
+    px = ((0.0, -p2, p1), (p2, 0.0, -p0), (-p1, p0, 0.0))
+    for i in range(3):
+        for j in range(3):
+            work[i, j] += mm[i][j]
+            mp = 0.0   # (M [p]x)[i, j]
+            pm = 0.0   # ([p]x M)[i, j]
+            for k in range(3):
+                mp += mm[i][k] * px[k][j]
+                pm += px[i][k] * mm[k][j]
+            work[i, 3 + j] -= mp
+            work[3 + i, j] += pm
+    for i in range(3):
+        for j in range(3):
+            pmp = 0.0   # ([p]x M [p]x)[i, j]
+            for k in range(3):
+                pm = 0.0
+                for l in range(3):
+                    pm += px[i][l] * mm[l][k]
+                pmp += pm * px[k][j]
+            work[3 + i, 3 + j] -= pmp
+
+
+@jit.kernel(inline="always")
+def _add_rotated(work, row, col, r, d0, d1, d2):
+    """Add R diag(d) R^T to the 3 x 3 block of ``work`` at (row, col); ``r`` R's nine entries."""
+    for i in range(3):
+        for j in range(3):
+            work[row + i, col + j] += d0 * r[3 * i] * r[3 * j] + d1 * r[3 * i + 1] * r[3 * j + 1] + \
+                d2 * r[3 * i + 2] * r[3 * j + 2]
+
+
+@jit.kernel
+def _solve(work, planar):
+    """Solve the symmetric positive definite system in ``work`` (6, 7) (the matrix, then the right-hand side) by
+    Gaussian elimination without pivoting, in place; the solution ends in column 6. ``planar``: x, y and the turn
+    about z alone (rows 0, 1, 5), the other unknowns set to 0."""
+    if planar:
+        keep = (0, 1, 5)
+        for a in range(3):
+            for b in range(3):
+                work[a, b] = work[keep[a], keep[b]]
+            work[a, 6] = work[keep[a], 6]
+        n = 3
+    else:
+        n = 6
+    for k in range(n):
+        pivot = work[k, k]
+        for i in range(k + 1, n):
+            f = work[i, k] / pivot
+            for j in range(k, n):
+                work[i, j] -= f * work[k, j]
+            work[i, 6] -= f * work[k, 6]
+    for k in range(n - 1, -1, -1):
+        s = work[k, 6]
+        for j in range(k + 1, n):
+            s -= work[k, j] * work[j, 6]
+        work[k, 6] = s / work[k, k]
+    if planar:
+        a2 = work[2, 6]
+        work[5, 6] = a2
+        work[2, 6] = work[3, 6] = work[4, 6] = 0.0
+
+
+@jit.kernel
+def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist, out, t):
+    """The free bodies' accelerations (see the module doc) into ``out`` (6, B) (a, then alpha), from ``acc``
+    holding each attachment node's F_i / m_i, and every attachment's acceleration a + alpha x rho + w x (w x rho)
+    into ``acc``; returns the power [W] of the fluid's forces on the bodies (drag and added mass)."""
+    dim = x.shape[0]
+    work = bodies.work
+    start, nodes, arm, node_added = bodies.start, bodies.nodes, bodies.arm, bodies.node_added
+    power = 0.0
+    for b in range(start.shape[0] - 1):
+        r = matrix_of(pose[3:7], b)
+        w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
+        v0, v1, v2 = twist[0, b], twist[1, b], twist[2, b]
+        for i in range(6):
+            for j in range(7):
+                work[i, j] = 0.0
+        # the body's own mass at its centre of gravity, its inertia and added mass
+        m = bodies.mass[b]
+        c0, c1, c2 = rotate(r, bodies.cog[0, b], bodies.cog[1, b], bodies.cog[2, b])
+        _add_mass_at(work, m, 0.0, 0.0, m, 0.0, m, c0, c1, c2)
+        for i in range(3):   # R I_b R^T
+            for j in range(3):
+                s = 0.0
+                for k in range(3):
+                    for l in range(3):
+                        s += r[3 * i + k] * bodies.inertia[k, l, b] * r[3 * j + l]
+                work[3 + i, 3 + j] += s
+        _add_rotated(work, 0, 0, r, bodies.added[0, b], bodies.added[1, b], bodies.added[2, b])
+        _add_rotated(work, 3, 3, r, bodies.added_rot[0, b], bodies.added_rot[1, b], bodies.added_rot[2, b])
+        # its weight and centripetal force at c, the gyroscopic moment w x (I w), buoyancy at its centre of buoyancy
+        e0, e1, e2 = cross(w0, w1, w2, c0, c1, c2)
+        n0, n1, n2 = cross(w0, w1, w2, e0, e1, e2)   # w x (w x c)
+        f0, f1, f2 = -m * n0, -m * n1 - m * gravity, -m * n2
+        wb = rotate_back(r, w0, w1, w2)
+        j0 = j1 = j2 = 0.0   # I_b (R^T w)
+        for l in range(3):
+            j0 += bodies.inertia[0, l, b] * wb[l]
+            j1 += bodies.inertia[1, l, b] * wb[l]
+            j2 += bodies.inertia[2, l, b] * wb[l]
+        i0, i1, i2 = rotate(r, j0, j1, j2)   # (R I_b R^T) w
+        g0, g1, g2 = cross(w0, w1, w2, i0, i1, i2)
+        m0, m1, m2 = cross(c0, c1, c2, f0, f1, f2)
+        work[0, 6] += f0
+        work[1, 6] += f1
+        work[2, 6] += f2
+        work[3, 6] += m0 - g0
+        work[4, 6] += m1 - g1
+        work[5, 6] += m2 - g2
+        lift = bodies.lift[b]
+        if lift != 0.0:
+            k0, _, k2 = rotate(r, bodies.cob[0, b], bodies.cob[1, b], bodies.cob[2, b])
+            work[1, 6] += lift
+            work[3, 6] -= k2 * lift   # (k x lift y)_x = -k_z lift
+            work[5, 6] += k0 * lift
+        # drag on the flow relative to the reference point, in body axes
+        u0, u1, u2 = -v0, -v1, -v2
+        if WITH_FLOW:
+            U0, U1, U2 = flow_at(pose[1, b], t, flow[0], flow[1])
+            u0 += U0
+            u1 += U1
+            u2 += U2
+        speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+        spin = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+        ub = rotate_back(r, u0, u1, u2)
+        for k in range(3):
+            fb = bodies.drag[k, b] * speed * ub[k]
+            tb = -bodies.drag_rot[k, b] * spin * wb[k]
+            for i in range(3):
+                work[i, 6] += r[3 * i + k] * fb
+                work[3 + i, 6] += r[3 * i + k] * tb
+                power += r[3 * i + k] * (fb * twist[i, b] + tb * twist[3 + i, b])
+        # the attachments: their forces, masses and added masses at their arms
+        for k in range(start[b], start[b + 1]):
+            i = nodes[k]
+            p0, p1, p2 = rotate(r, arm[0, k], arm[1, k], arm[2, k])
+            mi = 1.0 / inv_mass[i]
+            a_n, a_t = node_added[0, k], node_added[1, k]
+            q0, q1, q2 = node_tangent(x, i, around)
+            extra = a_t - a_n   # m I + a_n (I - q q^T) + a_t q q^T
+            m00 = mi + a_n + extra * q0 * q0
+            m01 = extra * q0 * q1
+            m02 = extra * q0 * q2
+            m11 = mi + a_n + extra * q1 * q1
+            m12 = extra * q1 * q2
+            m22 = mi + a_n + extra * q2 * q2
+            _add_mass_at(work, m00, m01, m02, m11, m12, m22, p0, p1, p2)
+            e0, e1, e2 = cross(w0, w1, w2, p0, p1, p2)
+            n0, n1, n2 = cross(w0, w1, w2, e0, e1, e2)   # w x (w x rho)
+            g0 = mi * acc[0, i] - (m00 * n0 + m01 * n1 + m02 * n2)
+            g1 = mi * acc[1, i] - (m01 * n0 + m11 * n1 + m12 * n2)
+            g2 = (mi * acc[2, i] if dim == 3 else 0.0) - (m02 * n0 + m12 * n1 + m22 * n2)
+            m0, m1, m2 = cross(p0, p1, p2, g0, g1, g2)
+            work[0, 6] += g0
+            work[1, 6] += g1
+            work[2, 6] += g2
+            work[3, 6] += m0
+            work[4, 6] += m1
+            work[5, 6] += m2
+        _solve(work, dim == 2)
+        a0, a1, a2, al0, al1, al2 = work[0, 6], work[1, 6], work[2, 6], work[3, 6], work[4, 6], work[5, 6]
+        for d in range(6):
+            out[d, b] = work[d, 6]
+        # the fluid's inertial force on the body's own added mass: -A_t a . v - A_r alpha . w
+        ab = rotate_back(r, a0, a1, a2)
+        vb = rotate_back(r, v0, v1, v2)
+        alb = rotate_back(r, al0, al1, al2)
+        for k in range(3):
+            power -= bodies.added[k, b] * ab[k] * vb[k] + bodies.added_rot[k, b] * alb[k] * wb[k]
+        for k in range(start[b], start[b + 1]):
+            i = nodes[k]
+            p0, p1, p2 = rotate(r, arm[0, k], arm[1, k], arm[2, k])
+            e0, e1, e2 = cross(w0, w1, w2, p0, p1, p2)
+            t0, t1, t2 = cross(al0, al1, al2, p0, p1, p2)
+            n0, n1, n2 = cross(w0, w1, w2, e0, e1, e2)
+            k0, k1, k2 = a0 + t0 + n0, a1 + t1 + n1, a2 + t2 + n2
+            acc[0, i] = k0
+            acc[1, i] = k1
+            if dim == 3:
+                acc[2, i] = k2
+            a_n, a_t = node_added[0, k], node_added[1, k]
+            if a_n != 0.0 or a_t != 0.0:   # the fluid's inertial force -A_i a_i on the node, at its velocity
+                q0, q1, q2 = node_tangent(x, i, around)
+                along = k0 * q0 + k1 * q1 + k2 * q2
+                f0 = a_n * k0 + (a_t - a_n) * along * q0
+                f1 = a_n * k1 + (a_t - a_n) * along * q1
+                f2 = a_n * k2 + (a_t - a_n) * along * q2
+                power -= f0 * v[0, i] + f1 * v[1, i] + (f2 * v[2, i] if dim == 3 else 0.0)
+    return power
+
+
+@jit.kernel
+def body_energy(bodies, pose, twist, gravity):
+    """The free bodies' mechanical energy [J]: kinetic, gravitational and buoyancy (see the module doc)."""
+    e = 0.0
+    for b in range(pose.shape[1]):
+        r = matrix_of(pose[3:7], b)
+        w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
+        c0, c1, c2 = rotate(r, bodies.cog[0, b], bodies.cog[1, b], bodies.cog[2, b])
+        e0, e1, e2 = cross(w0, w1, w2, c0, c1, c2)
+        g0, g1, g2 = twist[0, b] + e0, twist[1, b] + e1, twist[2, b] + e2
+        wb = rotate_back(r, w0, w1, w2)
+        spin = 0.0   # w . I w = (R^T w) . I_b (R^T w)
+        for k in range(3):
+            for l in range(3):
+                spin += wb[k] * bodies.inertia[k, l, b] * wb[l]
+        m = bodies.mass[b]
+        k1 = rotate(r, bodies.cob[0, b], bodies.cob[1, b], bodies.cob[2, b])[1]
+        e += 0.5 * m * (g0 * g0 + g1 * g1 + g2 * g2) + 0.5 * spin + m * gravity * (pose[1, b] + c1)
+        e -= bodies.lift[b] * (pose[1, b] + k1)
+    return e
+
+
+@jit.kernel
+def save_bodies(frame, pose, twist, frames_body):
+    """Copy the bodies' state into saved frame ``frame`` of ``frames_body`` (F, 13, B): pose rows, then twist."""
+    for b in range(pose.shape[1]):
+        for d in range(POSE):
+            frames_body[frame, d, b] = pose[d, b]
+        for d in range(TWIST):
+            frames_body[frame, POSE + d, b] = twist[d, b]
+
+
+def initial_state(scene) -> tuple[np.ndarray, np.ndarray]:
+    """The free bodies' pose (7, B) and twist (6, B) at t = 0: where the scene puts them, with its ``velocity`` and
+    ``angular_velocity`` [deg/s] (world axes)."""
+    bodies = free_bodies(scene)
+    dim = scene.dimension
+    pose, twist = np.zeros((POSE, len(bodies))), np.zeros((TWIST, len(bodies)))
+    for b, body in enumerate(bodies):
+        pose[:, b] = initial_pose(body, dim)
+        twist[:3, b] = vector3(body.velocity, dim)
+        twist[3:, b] = np.radians(turns3(body.angular_velocity, dim))
+    return pose, twist
+
+
+# ------------------------------------------------------------------------------------- saved frames
+
+
+def body_shapes(model) -> dict[str, tuple]:
+    """The rigid bodies' per-frame arrays and their shapes (none without rigid bodies): every body of the scene,
+    free, fixed or driven, in scene order."""
+    count = len(model.scene.rigid_bodies)
+    if not count:
+        return {}
+    dim = model.dim
+    return {"body_x": (count, dim), "body_q": (count, 4), "body_v": (count, dim), "body_w": (count, 3)}
+
+
+def body_frames(model, t: np.ndarray, state: np.ndarray | None) -> dict[str, np.ndarray]:
+    """Every rigid body's ``body_x`` (F, B, D) [m], ``body_q`` (F, B, 4), ``body_v`` (F, B, D) [m/s] and ``body_w``
+    (F, B, 3) [rad/s] at times t (F,): a free body's from the integrator's saved state (F, 13, B_free), a fixed
+    body's where the scene puts it, a driven body's from its prescribed motion."""
+    scene, dim = model.scene, model.dim
+    frames = len(t)
+    count = len(scene.rigid_bodies)
+    out = {"body_x": np.zeros((frames, count, dim)), "body_q": np.zeros((frames, count, 4)),
+           "body_v": np.zeros((frames, count, dim)), "body_w": np.zeros((frames, count, 3))}
+    free = 0
+    for b, body in enumerate(scene.rigid_bodies):
+        if body.kind == "free":
+            rows = np.asarray(state)[:, :, free]
+            free += 1
+            out["body_x"][:, b] = rows[:, 0:dim]
+            out["body_q"][:, b] = rows[:, 3:7]
+            out["body_v"][:, b] = rows[:, POSE:POSE + dim]
+            out["body_w"][:, b] = rows[:, POSE + 3:POSE + 6]
+        elif body.kind == "fixed":
+            pose = initial_pose(body, dim)
+            out["body_x"][:, b] = pose[:dim]
+            out["body_q"][:, b] = pose[3:]
+        else:
+            position, q, velocity, spin = driven_pose(model, body, np.asarray(t, dtype=float))
+            out["body_x"][:, b] = position[:, :dim]
+            out["body_q"][:, b] = q
+            out["body_v"][:, b] = velocity[:, :dim]
+            out["body_w"][:, b] = spin
+    return out
+
+
+def driven_pose(model, body, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A driven body's reference point (F, 3) [m], orientation (F, 4), velocity (F, 3) [m/s] and angular velocity
+    (F, 3) [rad/s] at times t (F,), from its prescribed motion (:func:`ropesim.model.motion.rigid_state`)."""
+    from .motion import rigid_state
+    from .rotation import quaternion_from_matrix
+
+    driven = [b for b in model.scene.rigid_bodies if b.kind == "driven"]
+    index = driven.index(body)
+    motions = model.motion.bodies
+    state = np.array([rigid_state(motions, index, float(tk), float(tk)) for tk in t]).reshape(len(t), 24)
+    q = quaternion_from_matrix(state[:, 9:18].reshape(-1, 3, 3))
+    return state[:, 0:3], q, state[:, 3:6], state[:, 18:21]
+
+
+def free_body_state(model, frames, part: slice = slice(None)) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """The free bodies' poses (F, 7, B) and twists (F, 6, B) in frames ``part`` of ``frames`` (anything with the
+    per-frame arrays body_x, body_q, body_v and body_w: a Trajectory, or a dict of them), for
+    :func:`ropesim.model.energy.energy_terms`; (None, None) without free bodies."""
+    which = [b for b, body in enumerate(model.scene.rigid_bodies) if body.kind == "free"]
+    if not which:
+        return None, None
+    get = frames.get if isinstance(frames, dict) else lambda name: getattr(frames, name)
+    x, q, v, w = (np.asarray(get(name)[part])[:, which] for name in ("body_x", "body_q", "body_v", "body_w"))
+    count, dim = x.shape[0], model.dim
+    pose, twist = np.zeros((count, POSE, len(which))), np.zeros((count, TWIST, len(which)))
+    pose[:, :dim] = np.swapaxes(x, 1, 2)
+    pose[:, 3:] = np.swapaxes(q, 1, 2)
+    twist[:, :dim] = np.swapaxes(v, 1, 2)
+    twist[:, 3:] = np.swapaxes(w, 1, 2)
+    return pose, twist
