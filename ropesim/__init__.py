@@ -12,6 +12,11 @@ Heavy modules (numba, matplotlib) load only when first used, so the command line
 
 __version__ = "0.1.0"
 
+from .stop import quiet_interrupts_while_loading, started_as_the_command_line  # noqa: E402
+
+if started_as_the_command_line():
+    quiet_interrupts_while_loading()   # until the command line takes Ctrl-C over (ropesim.cli)
+
 from .io.numba_cache import ensure_writable_cache  # noqa: E402
 
 ensure_writable_cache()  # before any kernel is defined: a read-only install caches its kernels elsewhere

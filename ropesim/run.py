@@ -1,6 +1,6 @@
 """Run a scene: an integrator in chunks, frames streamed out, progress, Ctrl-C and blow-up stops.
 
-Between chunks (each about a tenth of a second of work) control returns to Python: saved frames go to their
+Between chunks (each about a tenth of a second of wall time, measured, whatever a step costs) control returns to Python: saved frames go to their
 store, the progress bar moves, and an interrupt or a blow-up ends the run cleanly with every frame computed
 so far kept. Chunking never changes the numbers: the same scene gives bit-identical frames however it is cut.
 The integrator comes from one table by the scene's method name (:mod:`ropesim.integrate.methods`); this
@@ -22,7 +22,7 @@ import numpy as np
 from .integrate.grid import TimeGrid
 from .integrate.health import E0, LEDGER_COLUMNS, NEWTON_FAILED, NON_FINITE, OK, OVERSTRETCH, RUNAWAY_ENERGY
 from .integrate.health import RUNAWAY_FLOW_FRACTION
-from .integrate.base import Integrator
+from .integrate.base import ChunkSizer, Integrator
 from .integrate.methods import make_integrator
 from .model.build import Model, build
 from .scene.schema import Scene
@@ -112,8 +112,7 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
             if on_chunk is not None:
                 on_chunk(integrator, 0.0)
         status, bad_node, message, code = "completed", -1, "", OK
-        chunk = max(1, min(grid.steps, 20_000_000 // max(1, model.nodes * integrator.method.evaluations)))
-        chunk = _round_to(chunk, grid.save_every)
+        chunks = ChunkSizer(target_chunk_seconds, grid.save_every)
         frame_cap = grid.save_every * max(1, FRAME_BUFFER_BYTES // (2 * 8 * model.nodes * model.dim))
         compile_time = integrator.warm_up()
         start = time.perf_counter()
@@ -122,11 +121,11 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
                 status = INTERRUPTED
                 message = f"interrupted at t = {integrator.t:.6g} s (step {integrator.step} of {grid.steps})"
                 break
-            n = min(chunk, frame_cap, grid.steps - integrator.step)
+            n = min(chunks.steps, frame_cap, grid.steps - integrator.step)
             frames = integrator.new_frames(n)
             tick = time.perf_counter()
             done, written, code, node = integrator.advance(n, frames)
-            elapsed = time.perf_counter() - tick
+            chunks.measured(done, time.perf_counter() - tick)
             store.append(frames[0][:written], frames[1][:written], frames[2][:written], frames[3][:written])
             if code != OK:
                 status, bad_node = BLEW_UP, node
@@ -135,9 +134,6 @@ def integrate(model: Model, store, on_progress: Callable[[float, float], None] |
                 on_chunk(integrator, time.perf_counter() - start)
             if on_progress is not None:
                 on_progress(integrator.t, scene.integrator.t_end)
-            if elapsed > 0:
-                rate = done / elapsed
-                chunk = _round_to(max(1, int(rate * target_chunk_seconds)), grid.save_every)
         if hasattr(store, "drain"):
             store.drain()       # the frames still being written count in the run's wall time
     wall = time.perf_counter() - start
@@ -184,11 +180,6 @@ def _blow_up_message(model: Model, integrator: Integrator, code: int, node: int)
                        f"method {method}; a time step of {stable_dt:.3g} s or less would be stable")
 
 
-def _round_to(n: int, multiple: int) -> int:
-    """``n`` rounded to a positive multiple of ``multiple`` (so chunks end on saved frames)."""
-    return max(multiple, (n // multiple) * multiple)
-
-
 # Measured cost of the kernel per node and step [ns] (helicopter_mass at 21 and 201 nodes, the larger of the
 # two; scripts/bench_runfolder.py --costs), and of deriving and writing a saved frame per node [ns].
 NS_PER_NODE_STEP = {"symplectic_euler": 4.2, "verlet": 6.2, "yoshida4": 19.0, "pefrl": 20.0, "rk4": 180.0,
@@ -221,6 +212,7 @@ def estimate(scene: Scene, model: Model | None = None) -> Estimate:
 
 
 CHECKPOINT_SECONDS = 5.0   # a run folder commits a checkpoint at most this often (and at every stop)
+LOW_DISK_BYTES = 64 * 2 ** 20   # below this much free space, every chunk is a checkpoint
 
 
 def frame_specs(model: Model) -> dict[str, tuple]:
@@ -275,6 +267,11 @@ def resume(folder: str | Path, t_end: float | None = None, progress: bool = Fals
     writer = RunWriter.reopen(folder)
     try:
         scene, old_t_end = _scene_to_continue(folder, writer.manifest, t_end)
+        reached = (writer.manifest.get("checkpoint") or {}).get("t")
+        if t_end is not None and reached is not None and t_end < reached:
+            raise RunFolderError(f"{folder}: integrator.t_end = {t_end:g} s lies before the run's last checkpoint "
+                                 f"(t = {reached:.6g} s), where it goes on from; give a t_end of at least "
+                                 f"{reached:.6g} s")
         model = build(scene)
         grid = TimeGrid.of(scene)
         old = writer.manifest.get("grid", {})
@@ -347,8 +344,7 @@ def _manifest_info(scene: Scene, grid: TimeGrid) -> dict:
 
 
 def _run_in_memory(model: Model, grid: TimeGrid, progress: bool, stop, before_bar=None) -> "Trajectory":
-    from .analysis.summary import summarize
-    from .io.trajectory import FrameStore, Trajectory
+    from .io.trajectory import FrameStore
     from .model.tension import frame_arrays
 
     specs = frame_specs(model)
@@ -356,9 +352,17 @@ def _run_in_memory(model: Model, grid: TimeGrid, progress: bool, stop, before_ba
                        shapes={k: s for k, s in specs.items() if k not in ("t", "x", "v", "ledger")})
     with _progress(progress, model.scene, before_bar) as on_progress:
         outcome = integrate(model, store, on_progress, stop=stop)
-    arrays = store.arrays()
+    return _in_memory(model, store.arrays(), outcome)
+
+
+def _in_memory(model: Model, arrays: dict, outcome: RunOutcome, **more) -> "Trajectory":
+    """A trajectory held in memory from the run's frame arrays, with its summary (and ``more`` in it)."""
+    from .analysis.summary import summarize
+    from .io.trajectory import Trajectory
+
     summary = summarize(model, outcome, arrays["t"], arrays["x"], arrays["v"], arrays["tension"])
     _stopped_by(summary, outcome)
+    summary.update(more)
     extra = {k: v for k, v in arrays.items() if k in ("tension", "strain", "support", "ledger")}
     return Trajectory(t=arrays["t"], x=arrays["x"], v=arrays["v"], scene=model.scene, summary=summary, **extra)
 
@@ -435,8 +439,18 @@ class _DiskStore:
 
     def on_chunk(self, integrator: Integrator, wall: float) -> None:
         self._raise()
-        if time.monotonic() - self.last >= self.seconds:
+        if time.monotonic() - self.last >= self.seconds or self._disk_nearly_full():
             self.checkpoint(integrator, wall)
+
+    def _disk_nearly_full(self) -> bool:
+        """True when the run folder's disk has less than LOW_DISK_BYTES free: then every chunk is a checkpoint,
+        so a disk that fills up loses at most the last chunk (the frames of the others stay)."""
+        from .io.runfolder import free_bytes
+
+        try:
+            return free_bytes(self.writer.folder) < LOW_DISK_BYTES
+        except OSError:
+            return False
 
     def checkpoint(self, integrator: Integrator, wall: float) -> None:
         self.drain()
@@ -453,14 +467,16 @@ def _run_in_folder(model: Model, grid: TimeGrid, writer, integrator: Integrator 
     from .io.runfolder import LEDGER, TRAJECTORY
     from .io.trajectory import Trajectory
 
-    folder = writer.folder
     writer.expected_frames = grid.frames
     store = _DiskStore(writer, model, checkpoint_seconds, previous)
-    try:
-        with stop_signals() as flag, _progress(progress, model.scene, before_bar) as on_progress:
-            outcome = integrate(model, store, on_progress, stop=stop, integrator=integrator, interrupted=flag,
-                                on_chunk=store.on_chunk)
+    with stop_signals() as flag:   # until the folder is closed: a signal after the last chunk cannot tear that
+        try:
+            with _progress(progress, model.scene, before_bar) as on_progress:
+                outcome = integrate(model, store, on_progress, stop=stop, integrator=integrator, interrupted=flag,
+                                    on_chunk=store.on_chunk)
             store.compile_time = outcome.compile_time
+            if outcome.status == INTERRUPTED and writer.pending:
+                return _not_replaced(model, writer, store, outcome)
             store.checkpoint(outcome.integrator, outcome.wall_time)     # every stop is a checkpoint
             outcome.wall_time += store.wall0
             outcome.compile_time += store.compile0
@@ -473,10 +489,20 @@ def _run_in_folder(model: Model, grid: TimeGrid, writer, integrator: Integrator 
                 files = {TRAJECTORY: {k: a for k, a in arrays.items() if k != "ledger"},
                          LEDGER: ledger_arrays(arrays["t"], arrays["ledger"], outcome.energy0)}
                 writer.finish(outcome.status, outcome.integrator.state(), files, summary, outcome.message)
-    finally:
-        store.close()
-        writer.close()
-    return Trajectory.open(folder, verify=False)
+        finally:
+            store.close()
+            writer.close()
+    return Trajectory.open(writer.folder, verify=False)
+
+
+def _not_replaced(model: Model, writer, store, outcome: RunOutcome):
+    """A rerun stopped before its first checkpoint past t = 0: it is dropped and the earlier run in its folder
+    stays as it was; returns the stopped run's frames, in memory, its summary saying so."""
+    store.drain()
+    arrays = {name: np.array(a) for name, a in writer.arrays().items()}
+    folder = writer.discard()
+    outcome.message += f" before it replaced the earlier run in {folder}, which is kept as it was"
+    return _in_memory(model, arrays, outcome, kept_earlier_run=str(folder))
 
 
 @contextmanager

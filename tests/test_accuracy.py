@@ -182,6 +182,7 @@ def test_stiff_integrator_is_accurate_far_beyond_the_explicit_bound():
     assert stiff.force_evaluations < 100 * 10  # a handful of Newton iterations per step
 
 
+@pytest.mark.slow
 def test_stiff_integrator_order_on_a_closed_loop_with_bending():
     """The wrap-around (Woodbury) correction: sdirk2 is second order on a pinned loop with bending springs."""
     text = textwrap.dedent("""
@@ -235,6 +236,7 @@ def shooter(*sets: str):
     return ropesim.load_scene(SCENARIOS / "shooter_medium.toml", ["integrator.t_end=0.3", *width, *sets])
 
 
+@pytest.mark.slow
 def test_smoothed_edges_restore_the_order_of_rk4_and_sdirk2_on_the_shooter():
     """With the box's and guides' edges smoothed (edge_width = 0.2 m) the forces are smooth in x and RK4 is
     fourth order again, SDIRK2 second order (its Newton solve converges); with sharp edges neither converges
@@ -248,6 +250,7 @@ def test_smoothed_edges_restore_the_order_of_rk4_and_sdirk2_on_the_shooter():
         assert abs(order - expected) < 0.25, (method, errs)
 
 
+@pytest.mark.slow
 def test_exact_contact_kicks_restore_the_splitting_schemes_orders_on_the_smoothed_shooter():
     """The drive b_thrower (v_max - v_x) and the contact damping depend on v. A plain kick evaluates them at the
     velocity it starts from (an explicit Euler step of v' = a(x, v)): Verlet and PEFRL fall to first order.

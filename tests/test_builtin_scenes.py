@@ -119,7 +119,7 @@ def test_new_refuses_to_overwrite_or_a_bad_name(tmp_path, monkeypatch):
     assert invoke("new", "a").exit_code == 0
     assert "helicopter_mass" in Path("a.toml").read_text()   # the default source
     line = one_line_error(invoke("new", "a", "--from", "shooter_low"))
-    assert line == "ropesim: a.toml: exists; choose another NAME or add --force to replace it"
+    assert line == "ropesim: NAME a.toml: exists; add --force to replace it, or choose another name"
     assert invoke("new", "a", "--from", "shooter_low", "--force").exit_code == 0
     assert load_scene("a.toml").thrower is not None
     assert "NAME my scene: use letters" in one_line_error(invoke("new", "my scene"))

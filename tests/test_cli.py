@@ -63,22 +63,35 @@ def assert_one_line_error(result, *fragments: str) -> str:
     return lines[0]
 
 
-@pytest.fixture(scope="module")
-def runs(tmp_path_factory) -> dict[str, tuple]:
-    """Every scenario run through the CLI with t_end = 0.05 s: {name: (result, run folder)}."""
-    base = tmp_path_factory.mktemp("runs")
-    out = {}
-    for name in SCENES:
-        folder = base / name
+class _Runs(dict):
+    """Scenarios run through the CLI with t_end = 0.05 s, each the first time a test asks for it:
+    {name: (result, run folder)}."""
+
+    def __init__(self, base: Path):
+        super().__init__()
+        self.base = base
+
+    def __missing__(self, name: str) -> tuple:
+        folder = self.base / name
         sets = [a for key in SHORT_RUN for a in ("--set", key)]
-        out[name] = (invoke("run", SCENARIOS / f"{name}.toml", *sets, "--out", folder), folder)
-    return out
+        self[name] = (invoke("run", SCENARIOS / f"{name}.toml", *sets, "--out", folder), folder)
+        return self[name]
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory) -> _Runs:
+    return _Runs(tmp_path_factory.mktemp("runs"))
+
+
+# buoy_tether's sdirk2 loop with five fluid terms compiles for 20 s of CPU, alone a tenth of the quick loop: it
+# runs in the slow suite, every other scene in both.
+EVERY_SCENE = [pytest.param(n, marks=pytest.mark.slow) if n == "buoy_tether" else n for n in SCENES]
 
 
 # ------------------------------------------------------------------------------- run on every scene
 
 
-@pytest.mark.parametrize("name", SCENES)
+@pytest.mark.parametrize("name", EVERY_SCENE)
 def test_run_writes_exactly_the_run_folder(runs, name):
     result, folder = runs[name]
     assert result.exit_code == 0, (result.output, result.exception)
@@ -90,7 +103,7 @@ def test_run_writes_exactly_the_run_folder(runs, name):
     assert not [n for n in names if n.startswith(".") or n.endswith(".tmp")], names
 
 
-@pytest.mark.parametrize("name", SCENES)
+@pytest.mark.parametrize("name", EVERY_SCENE)
 def test_trajectory_covers_zero_to_t_end(runs, name):
     _, folder = runs[name]
     scene = load_scene(SCENARIOS / f"{name}.toml", list(SHORT_RUN))
@@ -127,7 +140,7 @@ def test_trajectory_covers_zero_to_t_end(runs, name):
             np.testing.assert_allclose(v[:, i], speed, rtol=0, atol=1e-12)
 
 
-@pytest.mark.parametrize("name", SCENES)
+@pytest.mark.parametrize("name", EVERY_SCENE)
 def test_summary_figures_agree_with_the_trajectory(runs, name):
     """The summary's figures, recomputed independently from trajectory.npz and the scene."""
     _, folder = runs[name]
@@ -178,7 +191,7 @@ def test_summary_figures_agree_with_the_trajectory(runs, name):
         assert "towed" not in s and "shooter" not in s
 
 
-@pytest.mark.parametrize("name", SCENES)
+@pytest.mark.parametrize("name", EVERY_SCENE)
 def test_rerun_from_the_resolved_scene_is_bit_identical(runs, name, tmp_path):
     _, folder = runs[name]
     resolved = folder / "scene.toml"

@@ -2,11 +2,10 @@
 
 Whether a run compiled is observed, not inferred from its timing: Numba broadcasts a ``numba:compile`` event
 whenever a function compiles (a cache miss) and none when it loads one from its cache, and the probe below
-counts them while it runs each built-in scene it is given, every method on helicopter_mass and on a mooring
-line of the user's that starts in its static shape (named to `ropesim compile`, since a scene compiles only
-its own parts), and the static solver of `ropesim equilibrium` on each, through the command line. The fast
-test prepares helicopter_mass and the mooring line alone; the slow one every built-in scene, from an empty
-cache.
+counts them while it runs every built-in scene, every method on helicopter_mass and on a mooring line of the
+user's that starts in its static shape (named to `ropesim compile`, since a scene compiles only its own parts),
+and the static solver of `ropesim equilibrium` on each, through the command line, from an empty cache (the
+slow suite: it compiles every built-in scene's parts).
 """
 
 from __future__ import annotations
@@ -80,12 +79,12 @@ PROBE = textwrap.dedent("""
     from ropesim.cli.app import app
     from ropesim.integrate.methods import METHODS
 
-    mooring, scenes = sys.argv[1], sys.argv[2:]
+    mooring, scenes = sys.argv[1], sys.argv[2:]   # mooring: "" for none
     cases = [(name, []) for name in scenes]
     cases += [("helicopter_mass", [f"integrator.method={m}"]) for m in METHODS]
     out = {}
     with tempfile.TemporaryDirectory() as tmp:
-        cases += [(mooring, [f"integrator.method={m}"]) for m in METHODS]
+        cases += [(mooring, [f"integrator.method={m}"]) for m in METHODS if mooring]
         for name, sets in cases:
             before = len(compiled)
             args = ["run", name, "--out", f"{tmp}/run", "--quiet", "--force", "--set", "integrator.t_end=0.02"]
@@ -95,7 +94,7 @@ PROBE = textwrap.dedent("""
             summary = json.load(open(f"{tmp}/run/summary.json"))
             case = " ".join(["mooring" if name == mooring else name, *sets])
             out[case] = [result.exit_code, compiled[before:], summary["compile_time_s"]]
-        for name in [*scenes, mooring]:
+        for name in [*scenes, mooring] if mooring else scenes:
             before = len(compiled)
             result = CliRunner().invoke(app, ["equilibrium", name])
             case = "equilibrium " + ("mooring" if name == mooring else name)
@@ -110,22 +109,24 @@ def _run(args: list[str], cache: str) -> subprocess.CompletedProcess:
                           env={**os.environ, "NUMBA_CACHE_DIR": cache})
 
 
-def _compile_then_probe(cache: str, folder: Path, scenes: list[str]) -> tuple[str, dict]:
-    """`ropesim compile SCENES` (every built-in scene if none; its table), then `ropesim compile` of the mooring
-    scene written in ``folder``, then the probe's runs of them all."""
-    mooring = folder / "mooring.toml"
-    mooring.write_text(MOORING)
+def _compile_then_probe(cache: str, folder: Path, scenes: list[str], mooring: bool) -> tuple[str, dict]:
+    """`ropesim compile SCENES` (every built-in scene if none; its table), then, with ``mooring``, `ropesim compile`
+    of the mooring scene written in ``folder``, then the probe's runs of them all."""
+    path = folder / "mooring.toml"
+    path.write_text(MOORING)
     done = _run(["-m", "ropesim", "compile", *scenes], cache)
     assert done.returncode == 0 and done.stderr == "", done.stderr
-    own = _run(["-m", "ropesim", "compile", str(mooring), "--quiet"], cache)
-    assert own.returncode == 0 and own.stdout == own.stderr == "", own.stderr
-    probe = _run(["-c", PROBE, str(mooring), *(scenes or builtin_names())], cache)
+    if mooring:
+        own = _run(["-m", "ropesim", "compile", str(path), "--quiet"], cache)
+        assert own.returncode == 0 and own.stdout == own.stderr == "", own.stderr
+    probe = _run(["-c", PROBE, str(path) if mooring else "", *(scenes or builtin_names())], cache)
     assert probe.returncode == 0, probe.stderr
     return done.stdout, json.loads(probe.stdout)
 
 
-def _check_nothing_compiles(runs: dict, scenes: list[str]) -> None:
-    assert len(runs) == len(scenes) + 2 * len(METHODS) + len(scenes) + 1   # the runs, then the static solves
+def _check_nothing_compiles(runs: dict, scenes: list[str], mooring: bool) -> None:
+    # the runs of the scenes, helicopter_mass and the mooring line with every method, then the static solves
+    assert len(runs) == len(scenes) + (1 + mooring) * len(METHODS) + len(scenes) + mooring
     for case, (code, compiled, compile_time) in runs.items():
         assert code == 0, case
         assert compiled == [], f"{case} compiled {compiled}"
@@ -135,27 +136,19 @@ def _check_nothing_compiles(runs: dict, scenes: list[str]) -> None:
         assert compile_time < 1.0, case
 
 
-def test_after_ropesim_compile_no_run_compiles_anything(tmp_path):
-    """Against this session's cache (earlier tests may have filled some of it; `ropesim compile` fills the
-    rest): then the scenes it was given, with every method, run on cache hits alone."""
-    table, runs = _compile_then_probe(os.environ["NUMBA_CACHE_DIR"], tmp_path, ["helicopter_mass"])
-    for name in [*METHODS, "static solver"]:
-        assert any(line.split()[:1] == [name.split()[0]] for line in table.splitlines()), (name, table)
-    assert "shares the loop of symplectic_euler" in table   # the splitting methods share one loop
-    assert "made ready for 1 scene:" in table
-    _check_nothing_compiles(runs, ["helicopter_mass"])
-
-
 @pytest.mark.slow
 def test_ropesim_compile_from_an_empty_cache_compiles_each_family_once(tmp_path):
-    table, runs = _compile_then_probe(str(tmp_path / "cache"), tmp_path, [])
+    """Every built-in scene, and a user's mooring line named to `ropesim compile`, from an empty cache."""
+    table, runs = _compile_then_probe(str(tmp_path / "cache"), tmp_path, [], mooring=True)
+    for name in [*METHODS, "static solver"]:
+        assert any(line.split()[:1] == [name.split()[0]] for line in table.splitlines()), (name, table)
     lines = {line.split()[0]: line for line in table.splitlines() if line.split()[:1]}
     for name in ("symplectic_euler", "rk4", "sdirk2"):
         assert "compiled" in lines[name], table
     for name in ("verlet", "yoshida4", "pefrl"):
         assert "shares the loop of symplectic_euler" in lines[name], table
     assert f"made ready for {len(builtin_names())} built-in scenes:" in table
-    _check_nothing_compiles(runs, builtin_names())
+    _check_nothing_compiles(runs, builtin_names(), mooring=True)
 
 
 @pytest.mark.parametrize("args, message", [
@@ -171,10 +164,11 @@ def test_compile_refuses_an_unknown_method_in_one_line(args, message):
 
 
 def test_compile_restricted_to_methods_prints_their_rows_only():
-    result = CliRunner().invoke(app, ["compile", "--method", "verlet", "--method", "rk4,verlet"])
+    result = CliRunner().invoke(app, ["compile", "helicopter_mass", "--method", "verlet", "--method", "rk4,verlet"])
     assert result.exit_code == 0, result.output
     rows = [line.split()[0] for line in result.output.splitlines()
             if line.split()[:1] and line.split()[0] in [*METHODS, "static"]]
     assert rows == ["verlet", "rk4"]
-    quiet = CliRunner().invoke(app, ["compile", "--method", "rk4", "--quiet"])
+    assert "made ready for 1 scene:" in " ".join(result.output.split())
+    quiet = CliRunner().invoke(app, ["compile", "helicopter_mass", "--method", "rk4", "--quiet"])
     assert quiet.exit_code == 0 and quiet.output == ""

@@ -86,8 +86,8 @@ def test_vtk_series_reads_back_with_meshio_and_lists_every_time(runs, name, tmp_
 def test_vtk_replaces_an_old_export_whole_and_leaves_nothing_behind(runs, tmp_path):
     traj = ropesim.Trajectory.open(runs["shooter_low"])
     out = tmp_path / "series"
-    out.mkdir()
-    (out / "stale.vtu").write_text("old")
+    export(traj, "vtk", out)
+    (out / "stale.vtu").write_text("old")           # a frame of an earlier, longer export
     export(traj, "vtk", out)
     assert not (out / "stale.vtu").exists() and len(list(out.iterdir())) == traj.frames * (
         2 if traj.support is not None else 1) + 1

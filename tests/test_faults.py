@@ -379,6 +379,7 @@ def test_damaged_checkpoint_is_refused(tmp_path):
         resume(folder)
 
 
+@pytest.mark.slow
 def test_a_torn_tail_past_the_checkpoint_is_ignored_and_cut(tmp_path, clean_root):
     folder = tmp_path / "run"
     scene = ropesim.load_scene(SCENE, ["integrator.t_end=3000"])
@@ -408,6 +409,7 @@ def test_picture_options_are_bounded(tmp_path):
         assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.output
 
 
+@pytest.mark.slow
 def test_a_sweep_point_resumes_its_unfinished_run(tmp_path):
     from ropesim.scene.schema import scene_to_toml
     from ropesim.sweep.points import run_point

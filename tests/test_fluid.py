@@ -259,6 +259,7 @@ def test_a_towed_line_settles_on_the_independently_solved_discrete_steady_state(
     assert traj.summary["tension"]["start_N"] == pytest.approx(reference.T[0], rel=1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("cd_t", [0.0, 0.05])
 def test_without_an_end_body_a_towed_line_streams_straight_at_the_critical_angle(cd_t):
     """sin(phi_c) / cos^2(phi_c) = rho Cd_n d U^2 / (2 w) (references.towed_cable.critical_angle); tangential
@@ -271,6 +272,7 @@ def test_without_an_end_body_a_towed_line_streams_straight_at_the_critical_angle
     np.testing.assert_allclose(angles, critical_angle(1.0, w, RHO, 1.2, 0.02), rtol=1e-9)
 
 
+@pytest.mark.slow
 def test_a_rope_falling_broadside_reaches_the_terminal_speed():
     """A horizontal rope (free) falls at sqrt(w / (rho Cd_n d / 2)), its length and segmentation irrelevant."""
     text = ("[rope]\nlength = 4.0\nsegments = 8\nmass_per_length = 0.6\ndiameter = 0.01\nEA = 1e5\n[initial]\n"
@@ -283,6 +285,7 @@ def test_a_rope_falling_broadside_reaches_the_terminal_speed():
     np.testing.assert_allclose(traj.v[-1][:, 0], 0.0, atol=1e-9)
 
 
+@pytest.mark.slow
 def test_a_body_dropped_in_water_follows_the_tanh_history_with_its_added_mass():
     """Two 2 kg bodies (1 l, CdA 0.01 m^2, Ca 0.5 each) on a nearly massless 1 cm rope, falling side by side:
     v(t) = v_t tanh(t / tau) with the inertial mass m + rho Ca V and the weight less buoyancy
@@ -299,7 +302,7 @@ def test_a_body_dropped_in_water_follows_the_tanh_history_with_its_added_mass():
     np.testing.assert_allclose(-traj.v[:, 0, 1], speed, rtol=2e-4)   # the rope's tiny drag and rounding
 
 
-@pytest.mark.parametrize("method", list(METHODS))
+@pytest.mark.parametrize("method", [m if m == "rk4" else pytest.param(m, marks=pytest.mark.slow) for m in METHODS])
 def test_a_neutrally_buoyant_rope_stays_put(method):
     """mu = rho pi d^2 / 4: weight and buoyancy cancel on every node, drag and springs are zero at rest."""
     mu = RHO * math.pi * 0.02 ** 2 / 4
@@ -344,6 +347,7 @@ ca_tangential = 0.3
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("buoyancy", [True, False])
 def test_a_rope_in_accelerating_water_follows_morisons_inertia_term(buoyancy):
     """A straight free rope twice as dense as the water, no drag, in a flow ramping in, U r(t): every node has the
@@ -437,6 +441,7 @@ def fluid_reference():
     return scene, run_once(scene, "pefrl", 0.0005 / 16).x
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", list(METHODS))
 def test_every_method_keeps_its_order_with_fluid_forces_a_ramped_flow_and_added_mass(method, fluid_reference):
     """Quadratic drag (normal and tangential) on the velocity relative to a flow that ramps up through the run,
@@ -450,6 +455,7 @@ def test_every_method_keeps_its_order_with_fluid_forces_a_ramped_flow_and_added_
     assert abs(order - METHODS[method].order) < 0.3, (method, order, errors)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", list(METHODS))
 def test_the_ledger_books_the_fluid_and_the_damping(method):
     """The fluid's work (drag against the current, added mass) and the axial damping's balance the energy:
@@ -463,6 +469,7 @@ def test_the_ledger_books_the_fluid_and_the_damping(method):
     assert ledger["relative_residual"] < (2e-3 if METHODS[method].order < 2 else 1e-4), ledger
 
 
+@pytest.mark.slow
 def test_the_stability_bound_holds_with_fluid_forces():
     """Just below the predicted bound a run in water stays sane, well above it blows up (verlet)."""
     from ropesim.analysis.stability import predicted_dt

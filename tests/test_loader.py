@@ -391,6 +391,36 @@ def test_invalid_toml_is_one_line():
     assert "not valid TOML" in assert_one_line(info.value, "dup.toml")
 
 
+def test_a_byte_order_mark_is_ignored(tmp_path):
+    """Notepad and some Windows editors start a UTF-8 file with a byte-order mark: the scene, and a path CSV."""
+    scene = tmp_path / "bom.toml"
+    scene.write_bytes(b"\xef\xbb\xbf" + tomli_w.dumps(LINE).encode())
+    assert load_scene(scene).rope.nodes == LINE["rope"]["nodes"]
+    (tmp_path / "path.csv").write_bytes(b"\xef\xbb\xbf0,0,0\n1000,1,0\n")
+    driven = {**LINE, "driven": [{"nodes": [0], "path": "path.csv"}]}
+    scene.write_bytes(b"\xef\xbb\xbf" + tomli_w.dumps(driven).encode())
+    assert load_scene(scene).driven[0].path_table[-1] == (1000.0, 1.0, 0.0)
+
+
+def test_text_and_path_sizes_are_capped(tmp_path):
+    """A 50 MB description took `check` minutes; a 1e300 path displacement passed (TOML numbers stop at 1e12)."""
+    with pytest.raises(SceneError) as info:
+        load({**LINE, "description": "x" * 50_000})
+    assert "at most 1000 characters" in assert_one_line(info.value)
+    with pytest.raises(SceneError) as info:
+        load({**LINE, "name": "n" * 300})
+    assert "at most 200 bytes" in assert_one_line(info.value)
+    (tmp_path / "path.csv").write_text("0,0,0\n1,1e300,0\n")
+    scene = tmp_path / "s.toml"
+    scene.write_text(tomli_w.dumps({**LINE, "driven": [{"nodes": [0], "path": "path.csv"}]}))
+    with pytest.raises(SceneError) as info:
+        load_scene(scene)
+    assert "at most 1e+12 in magnitude" in assert_one_line(info.value, str(scene))
+    with pytest.raises(SceneError) as info:
+        load({**LINE, "driven": [{"nodes": [0], "path_table": [[0, 0, 0], [1, 1e300, 0]]}]})
+    assert "at most 1e+12" in assert_one_line(info.value)
+
+
 def test_file_problems(tmp_path):
     for path, fragment in [(tmp_path / "nope.toml", "no such scene file"), (tmp_path, "is a folder")]:
         with pytest.raises(SceneError) as info:
@@ -450,7 +480,9 @@ SET_REFUSALS = [
     ("=5", "--set", "expected KEY=VALUE"),
     ("rope.mass.x=1", "rope.mass", "is a value, not a table"),
     ("guides.x.radius=1", "guides.x", "is a list; address its entries by number"),
-    ("guides.5.radius=1", "guides.5", "has 2 entries; --set can change one of them or add entry 2"),
+    ("guides.5.radius=1", "guides.5", "has 2 entries; --set can change guides.0 to guides.1 or add guides.2"),
+    ("overrides.5.mass=1", "overrides.5", "has no entries; --set can add overrides.0"),
+    ("driven.3.nodes=[0]", "driven.3", "has no entries; --set can add driven.0"),
     ("guides.²=1", "guides.²", "is a list"),
     ("rope.nodes=1", "rope.nodes", "must be an integer >= 2"),
     ("rope.node=5", "rope.node", "did you mean 'nodes'?"),
@@ -458,7 +490,8 @@ SET_REFUSALS = [
     ("integrator.dt=", "integrator.dt", "got ''"),
     ("guides.0=5", "guides.0", "must be a table"),
     ("rope=5", "rope", "must be a table"),
-    ("overrides.1.mass=2", "overrides.0.index", "missing"),
+    ("overrides.1.mass=2", "overrides.1", "has no entries; --set can add overrides.0"),
+    ("overrides.0.mass=2", "overrides.0.index", "missing"),
 ]
 
 
@@ -652,6 +685,7 @@ def test_random_set_overrides_are_accepted_or_refused_in_one_line(raw, items):
     _accepted_or_one_line(tomli_w.dumps(raw), sets)
 
 
+@pytest.mark.slow
 @FUZZ
 @given(rescaled_scenes())
 def test_rescaled_scenes_are_refused_in_one_line_or_run_cleanly(raw):

@@ -26,6 +26,7 @@ import numpy as np
 import pytest
 
 pytest.importorskip("moordyn")
+pytestmark = pytest.mark.slow   # four MoorDyn runs and four scenes of their own parts: the slow suite
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -171,7 +172,6 @@ def test_a_wrong_coefficient_breaks_the_agreement(moordyn_runs, regression):
 # ------------------------------------------------------------------------------------------------ full size
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize("name", list(CASES))
 def test_full_size_agreement_as_documented(name):
     """The documented comparison (docs/background/validation.md, scripts/compare_moordyn.py), case by case:
@@ -191,7 +191,6 @@ def test_full_size_agreement_as_documented(name):
     assert math.isfinite(d["top_max"])
 
 
-@pytest.mark.slow
 def test_the_comparison_script_runs(tmp_path):
     """scripts/compare_moordyn.py on one case, agreement only: its tables and its figure."""
     figure = tmp_path / "figure.png"

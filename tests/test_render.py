@@ -361,7 +361,8 @@ def test_gif_palette_keeps_the_most_frequent_colours_exactly():
 
 def test_failure_while_encoding_leaves_no_file_behind(runs, tmp_path, monkeypatch):
     out = tmp_path / "keep.gif"
-    out.write_bytes(b"the previous animation")
+    animate(runs["heli"], out, fps=25, end=0.1)     # the previous animation (ropesim's, so it may be replaced)
+    previous = out.read_bytes()
     calls = {"n": 0}
     real = FrameRenderer.render
 
@@ -377,7 +378,7 @@ def test_failure_while_encoding_leaves_no_file_behind(runs, tmp_path, monkeypatc
         with pytest.raises(KeyboardInterrupt):
             animate(runs["heli"], target, fps=25)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.gif"]
-    assert out.read_bytes() == b"the previous animation"
+    assert out.read_bytes() == previous
 
 
 def test_frame_sheet_png_size_times_and_determinism(runs, tmp_path):

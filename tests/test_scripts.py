@@ -35,6 +35,7 @@ def run(script: str, *args: str, env: dict | None = None, cwd: Path) -> subproce
                           env={**os.environ, **(env or {})}, timeout=600)
 
 
+@pytest.mark.slow
 def test_run_all_runs_and_animates_each_scene(tmp_path):
     scenes = [SCENARIOS / "helicopter_parachute.toml", SCENARIOS / "shooter_high.toml"]  # an open line, a loop
     animate = has_animate()  # `ropesim animate` (issue 3) may not be in this checkout yet
@@ -93,6 +94,7 @@ def test_scripts_say_when_ropesim_is_missing(tmp_path, script):
     assert "ropesim is not installed (not on PATH)" in result.stderr
 
 
+@pytest.mark.slow
 def test_sweep_air_resistance_collects_inclination_against_b(tmp_path):
     env = {"T_END": "0.3", "COUNT": "3", "B_MAX": "1.0", "OUT": "air", "JOBS": "2"}
     result = run("sweep_air_resistance.sh", env=env, cwd=tmp_path)

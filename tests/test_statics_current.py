@@ -48,6 +48,7 @@ CASES = [pytest.param(*case, marks=() if case in FAST else pytest.mark.slow)
                       + [(u, 2.0, 0.5) for u in (0.5, 1.0, 3.0)] + [(1.0, 0.6, 0.0)])]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("current,cd_normal,cd_tangential", CASES)
 def test_the_static_shape_in_a_current_is_where_a_long_damped_run_settles(current, cd_normal, cd_tangential):
     scene = hanging_line(current, cd_normal, cd_tangential)
@@ -66,6 +67,7 @@ def test_the_static_shape_in_a_current_is_where_a_long_damped_run_settles(curren
         assert shape.x[-1, 0] > 1.0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dimension,viscous", [(3, False), (2, True), (3, True)])
 def test_the_static_shape_in_an_oblique_current_and_with_linear_drag(dimension, viscous):
     scene = hanging_line(1.5, dimension=dimension, viscous=viscous)

@@ -33,6 +33,7 @@ def pinned_line(law: str, current=(1.0, 0.0), ramp_time: float = 0.0) -> ropesim
     return ropesim.scene_from_toml(tomli_w.dumps(scene))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("current", [(1.0, 0.0), (0.6, -0.3, 0.8)])
 def test_a_pinned_node_in_a_flow_is_held_against_b_times_the_flow(current):
     traj = ropesim.simulate(pinned_line("drag", current, ramp_time=0.5))
@@ -43,6 +44,7 @@ def test_a_pinned_node_in_a_flow_is_held_against_b_times_the_flow(current):
     assert np.allclose(equilibrium(pinned_line("drag", current)).supports[:2], -3.0 * U[None, :], rtol=1e-12)
 
 
+@pytest.mark.slow
 def test_the_linear_drag_and_the_same_viscous_drag_give_the_same_support():
     linear, viscous = (ropesim.simulate(pinned_line(law)) for law in ("drag", "viscous"))
     middle = 1   # the viscous law acts on each node's length: the middle node's is the whole metre

@@ -246,6 +246,7 @@ def test_a_run_that_raises_is_recorded_with_its_error(tmp_path):
     assert error.startswith("SceneError: ") and "every scene needs a [initial] table" in error
 
 
+@pytest.mark.slow
 def test_a_method_several_runs_use_compiles_once_before_the_workers_start(monkeypatch, tmp_path):
     """Workers would each compile the same loop at the same time; the sweep compiles (or loads) it once itself.
     A method used by one run alone compiles in its worker, alongside the others."""

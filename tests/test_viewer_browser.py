@@ -68,6 +68,7 @@ def assert_clean(opened) -> None:
     assert opened.errors == [], f"console errors: {opened.errors}"
 
 
+@pytest.mark.slow
 def test_every_built_in_scene_opens_offline_draws_and_plays(browser, builtin_runs):
     for name, traj in builtin_runs.items():
         page = write_page(traj.folder, traj.folder / "view.html")
@@ -189,6 +190,7 @@ def test_lines_bodies_and_a_sea_are_drawn(browser, tmp_path):
     assert drawn_fraction(picture(opened.canvas_png())) > 0.01
 
 
+@pytest.mark.slow
 def test_a_notebook_iframe_runs_the_viewer(browser, builtin_runs, tmp_path):
     """Jupyter shows `_repr_html_` as it is: here, in a page of its own, the sandboxed iframe's viewer starts."""
     traj = builtin_runs["helicopter_mass"]

@@ -227,8 +227,6 @@ def work_precision_figure(report: Report):
 @with_picture_text
 def plot(report: Report, path) -> None:
     """Write :func:`work_precision_figure` to the PNG ``path``."""
-    from ..io.atomic import atomic_output
+    from ..render.output import save_png
 
-    fig = work_precision_figure(report)
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
+    save_png(work_precision_figure(report), path, 110)

@@ -352,8 +352,6 @@ def stability_figure(result: SweepResult):
 @with_picture_text
 def plot_sweep(result: SweepResult, path) -> None:
     """Write :func:`stability_figure` to the PNG ``path``."""
-    from ..io.atomic import atomic_output
+    from ..render.output import save_png
 
-    fig = stability_figure(result)
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
+    save_png(stability_figure(result), path, 110)

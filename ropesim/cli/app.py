@@ -55,7 +55,30 @@ class Command(_CleanHelp, TyperCommand):
 
 
 class Group(_CleanHelp, TyperGroup):
-    pass
+    """Ctrl-C before a command's own clean stop (while it parses, loads, compiles or checks) is one line and
+    exit 130; Typer's own handling would exit 130 without a word."""
+
+    def make_context(self, *args, **kwargs):
+        with _interrupt_in_one_line():
+            return super().make_context(*args, **kwargs)
+
+    def invoke(self, ctx):
+        with _interrupt_in_one_line():
+            return super().invoke(ctx)
+
+
+class _interrupt_in_one_line:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        if kind is KeyboardInterrupt:
+            from .status import close_early
+
+            close_early()
+            typer.echo("ropesim: interrupted", err=True)
+            raise typer.Exit(130) from None
+        return False
 
 
 app = typer.Typer(
@@ -205,8 +228,9 @@ def run(
         fail(f"{where}: {summary['message']}; frames up to then are in {folder}", EXIT_BLEW_UP)
     if summary["status"] == INTERRUPTED:
         by = summary.get("stopped_by", "SIGINT")
+        kept = summary.get("kept_earlier_run")
         fail(f"{where}: {summary['message']}" + (f" by {by}" if by != "SIGINT" else "")
-             + f"; frames up to then are in {folder}; `ropesim run --resume {folder}` continues it",
+             + ("" if kept else f"; frames up to then are in {folder}; `ropesim run --resume {folder}` continues it"),
              exit_code(name=by))
     if animate_:
         _animate(folder, None, quiet, fps=fps)
@@ -214,6 +238,7 @@ def run(
 
 def _run_command(scene_file, out, sets, resume, quiet, force, progress, status):
     """`ropesim run`'s work up to the finished run: (trajectory, run folder, how to name it in messages)."""
+    from ..io.guard import output_folder
     from ..io.runfolder import DiskFull, RunFolderError
     from ..run import simulate
 
@@ -233,12 +258,9 @@ def _run_command(scene_file, out, sets, resume, quiet, force, progress, status):
         status.watch()   # imports Numba, which the checks below need anyway
         _check_time_step(scene, where, force, quiet)
         folder = out if out is not None else Path("runs") / scene.name
-        if folder.exists() and not folder.is_dir():
-            fail(f"--out {folder}: exists and is not a folder")
-        blocked = next((p for p in folder.parents if p.exists() and not p.is_dir()), None)
-        if blocked is not None:
-            fail(f"--out {folder}: cannot write the run folder: {blocked} is a file, not a folder")
+        _may_write(lambda: output_folder(folder, "run"))     # at once, not after the kernel compiled
         _check_size(scene, where, folder, force, quiet)
+        _say_what_replacing_costs(folder, quiet)
         status.update(f"Running {scene.name}")
         run_it = (lambda: simulate(scene, folder, progress=progress, before_bar=status.stop))
     try:
@@ -250,6 +272,34 @@ def _run_command(scene_file, out, sets, resume, quiet, force, progress, status):
     except OSError as exc:
         fail(f"{folder}: cannot write the run folder ({exc.strerror or exc})", EXIT_WRITE)
     return traj, folder, where
+
+
+def _may_write(check):
+    """``check()`` (a :mod:`ropesim.io.guard` check); its refusal is one line and exit 2."""
+    from ..io.guard import WriteRefused
+
+    try:
+        return check()
+    except WriteRefused as exc:
+        fail(str(exc))
+
+
+def _say_what_replacing_costs(folder: Path, quiet: bool) -> None:
+    """Before a run replaces a finished run: one line saying so, and until when Ctrl-C keeps the earlier run."""
+    from ..io.runfolder import FINISHED, RunFolderError, read_manifest
+    from ..run import CHECKPOINT_SECONDS
+
+    try:
+        manifest = read_manifest(folder) if folder.is_dir() else None
+    except RunFolderError:
+        manifest = None
+    if quiet or not manifest or manifest.get("status") not in FINISHED:
+        return
+    t_end = (manifest.get("grid") or {}).get("t_end")
+    typer.echo(f"ropesim: replacing the {manifest['status'].replace('_', ' ')} run in {folder}"
+               + (f" (t = 0 .. {t_end:g} s)" if isinstance(t_end, (int, float)) else "")
+               + f": it is deleted at the new run's first checkpoint, {CHECKPOINT_SECONDS:g} s in; Ctrl-C "
+               f"before then keeps it", err=True)
 
 
 def _resume_t_end(sets: list[str] | None) -> float | None:
@@ -459,12 +509,13 @@ def equilibrium(
     from ..io.atomic import write_text_atomic
     from ..scene.schema import scene_to_toml
 
+    from ..io.guard import output_file
+
     scene, where = _load(scene_file, sets)
     if out is not None:
         if out.suffix != ".toml":
             fail(f"--out {out}: must name a .toml file")
-        if out.exists() and not force:
-            fail(f"--out {out}: exists; choose another file or add --force to replace it")
+        target = _may_write(lambda: output_file(out, replace=force, force_hint=True))
     with _compiling():   # the static solver compiles on its first use
         shape = solve(scene)
     if as_json:
@@ -476,9 +527,9 @@ def equilibrium(
              f"{shape.iterations} iterations); check that the rope can hang where the scene holds it", 1)
     if out is not None:
         try:
-            write_text_atomic(out, scene_to_toml(as_points_scene(shape)))
+            write_text_atomic(target, scene_to_toml(as_points_scene(shape)))
         except OSError as exc:
-            fail(f"--out {out}: cannot write it ({exc.strerror or exc})", EXIT_WRITE)
+            fail(_write_failure(exc, out), EXIT_WRITE)
         typer.echo(f"written: {out} (run it with `ropesim run {out}`)", err=as_json)
 
 
@@ -508,6 +559,7 @@ def new(
     keys it leaves out, commented out at their defaults. Then: ropesim check NAME.toml; ropesim run NAME.toml.
     """
     from ..io.atomic import write_text_atomic
+    from ..io.guard import output_file
     from ..scene.builtin import NAME, annotated_copy
 
     target = Path(name) if name.endswith(".toml") else Path(f"{name}.toml")
@@ -515,14 +567,13 @@ def new(
     if not NAME.match(stem):
         fail(f"NAME {name}: use letters, digits, '_', '-' or '.', starting with a letter or digit "
              f"(it names the file and the run folder runs/{stem}/)")
-    if target.exists() and not force:
-        fail(f"{target}: exists; choose another NAME or add --force to replace it")
+    real = _may_write(lambda: output_file(target, replace=force, option="NAME", force_hint=True))
     source = _source(from_)
     _load(from_, None)  # the source must itself be a valid scene
     try:
-        write_text_atomic(target, annotated_copy(source.path, stem, source.label))
+        write_text_atomic(real, annotated_copy(source.path, stem, source.label))
     except OSError as exc:
-        fail(f"{target}: cannot write ({exc.strerror or exc})")
+        fail(_write_failure(exc, target), EXIT_WRITE)
     typer.echo(f"{target}: a copy of {source.label} to edit; then `ropesim check {target}` and "
                f"`ropesim run {target}`")
 
@@ -549,6 +600,9 @@ def sweep(
                                                "instead of local processes; needs the dask extra "
                                                "(dask.distributed).")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")] = False,
+    yes: Annotated[bool, typer.Option("--yes", "-y", help=f"Start a sweep of more than {LARGE_SWEEP:,} runs "
+                                                          f"without asking (needed where nobody can answer: "
+                                                          f"no terminal).")] = False,
 ) -> None:
     """Run a scene for every combination of --set values, in parallel; rerun, it resumes.
 
@@ -562,12 +616,15 @@ def sweep(
     try:
         with _compiling(not quiet):   # the sweep compiles each method's kernels once before its workers start
             result = run_sweep(_source(scene_file).path, sets or [], out=out, jobs=jobs, scheduler=scheduler,
-                               plots=plots or [], quiet=quiet)
+                               plots=plots or [], quiet=quiet, before=lambda n, root: _sweep_start(n, root, quiet, yes))
     except SweepError as exc:
         fail(str(exc))
+    except OSError as exc:
+        fail(_write_failure(exc), EXIT_WRITE)
     if not quiet:
-        typer.echo(f"{result.csv_path}: {len(result.rows)} runs ({result.ran} run now, {result.skipped} kept)"
-                   + "".join(f"\n{path}" for path in result.plots))
+        not_run = f", {result.not_run} not started" if result.not_run else ""
+        typer.echo(f"{result.csv_path}: {len(result.rows)} runs ({result.ran} run now, {result.skipped} kept"
+                   f"{not_run})" + "".join(f"\n{path}" for path in result.plots))
     if result.interrupted:
         fail(f"sweep interrupted{'' if result.stopped_by == 'SIGINT' else f' by {result.stopped_by}'}; rerun the "
              f"same command to finish it (unfinished runs continue from their checkpoints) ({result.csv_path})",
@@ -575,6 +632,22 @@ def sweep(
     if result.failed:
         fail(f"{len(result.failed)} of {len(result.rows)} runs did not complete; see the error column of "
              f"{result.csv_path}", EXIT_BLEW_UP)
+
+
+LARGE_SWEEP = 1000   # runs from which a sweep asks before it starts (--yes: without asking)
+
+
+def _sweep_start(count: int, root: Path, quiet: bool, yes: bool) -> None:
+    """Say how many runs go where, at once; before a sweep of more than LARGE_SWEEP runs, ask (on a terminal)
+    or, where nobody can answer, refuse without --yes (exit 2)."""
+    if count > LARGE_SWEEP and not yes:
+        if not sys.stdin.isatty():
+            fail(f"sweep: {count:,} runs into {root}/; a sweep of more than {LARGE_SWEEP:,} runs starts with --yes "
+                 f"(or answer on a terminal)")
+        if not typer.confirm(f"ropesim: sweep: {count:,} runs into {root}/; start?", default=False, err=True):
+            fail("sweep: not started", 1)
+    elif not quiet:
+        typer.echo(f"ropesim: sweep: {count:,} run{'s' if count != 1 else ''} into {root}/", err=True)
 
 
 # ------------------------------------------------------------------------- pictures (ropesim.render)
@@ -594,7 +667,9 @@ def _check_fps(fps: float) -> float:
     return fps
 
 
-MAX_FPS, SIZE_RANGE, WIDTH_RANGE, COLUMNS_RANGE, COUNT_RANGE = 1000, (32, 8192), (100, 16384), (1, 64), (1, 1000)
+from ..render import SIZE_RANGE  # noqa: E402
+
+MAX_FPS, WIDTH_RANGE, COLUMNS_RANGE, COUNT_RANGE = 1000, (100, 16384), (1, 64), (1, 1000)
 
 
 def _bounded(option: str, low: int, high: int, what: str):
@@ -655,19 +730,31 @@ def _formats(incomplete: str) -> list[str]:
     return [f for f in FORMATS if f.startswith(incomplete.lower())]
 
 
-def _picture(make):
-    """Call ``make()``; an unusable run folder or request, or an unwritable output, prints one line, exits 2."""
+def _picture(make, what: str = "picture"):
+    """Call ``make()``: an unusable run folder or request, or an output that is not ropesim's to replace, prints
+    one line and exits 2; an output that cannot be written (a full disk, a read-only folder) one line naming it,
+    exit 4."""
+    from ..io.guard import WriteRefused
     from ..render import RenderError
     from ..io.runfolder import RunFolderError
 
     try:
         return make()
-    except (RunFolderError, RenderError) as exc:
+    except (RunFolderError, RenderError, WriteRefused) as exc:
         fail(str(exc))
     except OSError as exc:
-        fail(f"{exc.filename or 'output'}: cannot write ({exc.strerror or exc})")
+        fail(_write_failure(exc), EXIT_WRITE)
     except (KeyboardInterrupt, Stopped) as exc:
-        fail("interrupted; no picture written", exit_code(exc))
+        fail(f"interrupted; no {what} written", exit_code(exc))
+
+
+def _write_failure(exc: OSError, default: Path | str = "output") -> str:
+    """One line for a failed write, naming the file asked for (never a temporary one)."""
+    from ..io.atomic import WriteFailed
+
+    if isinstance(exc, WriteFailed):
+        return str(exc)
+    return f"{exc.filename or default}: cannot write it ({exc.strerror or exc})"
 
 
 def _animate(run_dir: Path, out: Optional[Path], quiet: bool, **options) -> None:
@@ -877,11 +964,9 @@ def export(
 
     traj = _open_run(run_dir, "export")
     try:
-        result = write(traj, to.strip().lower(), out, start=start, stop=stop)
+        result = _picture(lambda: write(traj, to.strip().lower(), out, start=start, stop=stop), "export")
     except ExportError as exc:
         fail(str(exc))
-    except OSError as exc:
-        fail(f"{exc.filename or out or run_dir}: cannot write ({exc.strerror or exc})")
     if not quiet:
         typer.echo(f"{result.path}: {result.frames} frames of {traj.nodes} nodes, {result.files} "
                    f"file{'s' if result.files > 1 else ''}, {result.bytes / 1e3:,.0f} kB")
@@ -956,6 +1041,7 @@ def accuracy(
     scene, _ = _load(scene_file, sets)
     names, ladder = _methods(methods), _numbers(dts, "--dts")
     folder = out if out is not None else Path("runs") / f"accuracy-{scene.name}"
+    files = _may_write(lambda: _analysis_files(folder, "accuracy.csv", "accuracy.png"))
     base = scene.integrator.dt
     rungs = ladder or [base * f for f in (4, 2, 1, 0.5, 0.25, 0.125)]
     t_end = scene.integrator.t_end
@@ -968,12 +1054,22 @@ def accuracy(
     except (KeyboardInterrupt, Stopped) as exc:
         fail("accuracy interrupted; nothing written", exit_code(exc))
     try:
-        folder.mkdir(parents=True, exist_ok=True)
-        write_csv(report, folder / "accuracy.csv")
-        plot(report, folder / "accuracy.png")
+        write_csv(report, files[0])
+        plot(report, files[1])
     except OSError as exc:
-        fail(f"{folder}: cannot write ({exc.strerror or exc})")
+        fail(_write_failure(exc, folder), EXIT_WRITE)
     print_accuracy(report, folder)
+
+
+def _analysis_files(folder: Path, *names: str) -> list[Path]:
+    """The files an analysis writes into ``folder``, each checked by the write guard (links followed; a file
+    ropesim did not write is refused)."""
+    from ..io.guard import WriteRefused, follow, output_file
+
+    real = follow(folder)
+    if real.exists() and not real.is_dir():
+        raise WriteRefused(f"--out {folder}: exists and is not a folder")
+    return [output_file(real / name, option="--out") for name in names]
 
 
 @app.command(cls=Command, rich_help_panel=STUDIES)
@@ -1004,6 +1100,7 @@ def stability(
     names, ladder = _methods(methods), _numbers(fractions, "--fractions")
     ks = _numbers(stiffness, "--k")
     folder = out if out is not None else Path("runs") / f"stability-{scene.name}"
+    files = _may_write(lambda: _analysis_files(folder, "stability.csv", "bounds.csv", "stability.png"))
     probes = (len(ladder or range(20)) + 20) * len(ks or [0])       # the ladder and about 20 bisection probes
     _warn_ladder(scene, {m: probes * steps for m in (names or METHOD_NAMES)}, "stability")
     try:
@@ -1012,10 +1109,10 @@ def stability(
     except (KeyboardInterrupt, Stopped) as exc:
         fail("stability interrupted; nothing written", exit_code(exc))
     try:
-        write_sweep(result, folder)
-        plot_sweep(result, folder / "stability.png")
+        write_sweep(result, files[0].parent)
+        plot_sweep(result, files[2])
     except OSError as exc:
-        fail(f"{folder}: cannot write ({exc.strerror or exc})")
+        fail(_write_failure(exc, folder), EXIT_WRITE)
     print_stability(result, folder)
 
 

@@ -76,7 +76,7 @@ def print_summary(summary: dict, folder: Path) -> None:
     table.add_column("", style="bold")
     table.add_column("", overflow="fold")  # words wrap; a word too long for the column folds, never cut
     rows = summary_rows(summary)
-    rows.append(("written", f"{folder}/ (trajectory.npz, scene.toml, summary.json)"))
+    rows.append(("written", written(summary, folder)))
     for key, value in rows:
         table.add_row(key, value)
     _console().print(table)
@@ -141,6 +141,16 @@ def summary_rows(summary: dict) -> list[tuple[str, str]]:
     if summary.get("message"):
         rows.append(("stopped", summary["message"]))
     return rows
+
+
+def written(summary: dict, folder: Path) -> str:
+    """What the run left in its folder: the finished run's files, an interrupted run's checkpoint, or (a rerun
+    stopped before it replaced the earlier run) nothing."""
+    if summary.get("kept_earlier_run"):
+        return f"nothing: {folder}/ still holds the earlier run"
+    if summary["status"] == "interrupted":
+        return f"{folder}/ (frames in checkpoint/, scene.toml, summary.json; `ropesim run --resume {folder}` goes on)"
+    return f"{folder}/ (trajectory.npz, ledger.npz, scene.toml, summary.json)"
 
 
 def print_check(scene: Scene, source: Path) -> None:

@@ -132,14 +132,23 @@ class Method:
         return stable_step(self, 1.0)
 
 
+def spectral_radius(m) -> float:
+    """The largest |eigenvalue| of a real 2x2 matrix, from its trace and determinant (NaN if not finite)."""
+    (a, b), (c, d) = m
+    half, det = 0.5 * (a + d), a * d - b * c
+    disc = half * half - det
+    if disc >= 0.0:
+        root = math.sqrt(disc)
+        return max(abs(half + root), abs(half - root))
+    return math.sqrt(det) if det >= 0.0 else math.nan   # a complex pair: |lambda|^2 = det (NaN: not finite)
+
+
 def _stable(method: Method, h: float, omega: float, gamma_force: float, gamma_drag: float) -> bool:
     try:
         m = method.amplification(h, omega, gamma_force, gamma_drag)
     except OverflowError:   # a backward kick's e^(gamma |c| h) beyond the float range: the kernel's factor is inf
         return False
-    if not np.all(np.isfinite(m)):
-        return False
-    return bool(np.max(np.abs(np.linalg.eigvals(m))) <= 1.0 + 1e-9)
+    return spectral_radius(m.tolist()) <= 1.0 + 1e-9   # False for inf and NaN entries
 
 
 @lru_cache(maxsize=4096)
@@ -280,19 +289,42 @@ class Integrator:
         self.step = int(state["step"])
 
 
+PROBE_STEPS = 16   # the first chunk: its wall time measures the rate (a scene's cost per step is not known
+                   # before: contact and fluid terms make some scenes 100 times dearer per node than others)
+
+
+class ChunkSizer:
+    """Chunk lengths bounded in wall time: control comes back to Python (signals, checkpoints, progress) about
+    every ``seconds``, whatever a step costs. The first chunk is a short probe; each next one is the measured
+    rate times ``seconds``, grown at most GROWTH times per chunk (a rate measured on a short chunk may be off),
+    rounded down to whole saved frames when it covers one or more. The numbers never depend on the cuts."""
+
+    GROWTH = 4
+
+    def __init__(self, seconds: float, save_every: int = 1, first: int = PROBE_STEPS):
+        self.seconds, self.save_every, self.steps = seconds, save_every, max(1, first)
+
+    def measured(self, done: int, elapsed: float) -> None:
+        if done <= 0:
+            return
+        wanted = done * self.seconds / elapsed if elapsed > 0 else done * self.GROWTH
+        n = max(1, min(int(wanted), done * self.GROWTH))
+        self.steps = n - n % self.save_every if n >= self.save_every else n
+
+
 def advance_in_chunks(integrator: Integrator, steps: int, target_chunk_seconds: float = 0.1):
-    """``integrator.advance(steps)`` cut into chunks of about ``target_chunk_seconds`` (the numbers are the
-    same however it is cut), so that Ctrl-C or SIGTERM are honoured within a chunk instead of after the whole
-    run. Returns the last chunk's Advance with ``done`` summed; stops at the first bad status."""
-    done, chunk, result = 0, min(steps, 1000), None
+    """``integrator.advance(steps)`` cut into chunks of about ``target_chunk_seconds`` of wall time (see
+    :class:`ChunkSizer`; the numbers are the same however it is cut), so that Ctrl-C or SIGTERM are honoured
+    within a chunk instead of after the whole run. Returns the last chunk's Advance with ``done`` summed; stops
+    at the first bad status."""
+    done, result = 0, None
+    chunks = ChunkSizer(target_chunk_seconds)
     while done < steps or result is None:
-        n = min(chunk, steps - done)
+        n = min(chunks.steps, steps - done)
         tick = time.perf_counter()
         result = integrator.advance(n)
-        elapsed = time.perf_counter() - tick
+        chunks.measured(result.done, time.perf_counter() - tick)
         done += result.done
         if result.status != OK or n == 0:
             break
-        if elapsed > 0:
-            chunk = max(1, int(result.done / elapsed * target_chunk_seconds))
     return result._replace(done=done)

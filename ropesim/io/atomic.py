@@ -10,6 +10,7 @@ from __future__ import annotations
 import errno
 import json
 import os
+import re
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
@@ -23,6 +24,7 @@ def _umask() -> int:
 
 
 FILE_MODE = 0o666 & ~_umask()  # what open() would give a new file (mkstemp's own 0600 would hide results)
+TEMPORARY_NAME = re.compile(r"^\.(.+)\.[a-z0-9_]{8}\.tmp(\.[^.]*)?$")   # atomic_output's .STEM.XXXXXXXX.tmp.EXT
 
 
 def fsync_path(path: str | Path) -> None:
@@ -40,24 +42,45 @@ def fsync_path(path: str | Path) -> None:
         os.close(fd)
 
 
+class WriteFailed(OSError):
+    """Writing an output file failed (a full disk, a read-only folder); ``str()`` is one line naming the file
+    that was asked for, never the temporary file beside it. ``errno`` is the failure's (ENOSPC, EACCES, ...)."""
+
+    def __init__(self, path: str | Path, exc: OSError):
+        super().__init__(exc.errno, exc.strerror or str(exc), str(path))
+        self.path = Path(path)
+
+    def __str__(self) -> str:
+        return f"{self.path}: cannot write it ({self.strerror})"
+
+
 @contextmanager
 def atomic_output(path: str | Path, durable: bool = True) -> Iterator[Path]:
     """Yield a temporary path beside ``path`` (same extension); move it into place only if the block succeeds.
 
     Any error or interrupt inside the block removes the temporary file, so ``path`` is either its old self
     or the complete new file, with the permissions a newly created file gets. With ``durable`` the file is
-    flushed to disk before the rename and the folder after it.
+    flushed to disk before the rename and the folder after it. An OSError on the way (making the folder or the
+    temporary file, writing, renaming) comes out as :class:`WriteFailed`, naming ``path``.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}", dir=path.parent)
-    os.close(fd)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}", dir=path.parent)
+        os.close(fd)
+    except OSError as exc:
+        raise WriteFailed(path, exc) from None
     try:
         yield Path(tmp)
         os.chmod(tmp, FILE_MODE)
         if durable:
             fsync_path(tmp)
         os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        if isinstance(exc, WriteFailed):
+            raise
+        raise WriteFailed(path, exc) from None
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

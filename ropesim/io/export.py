@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from .atomic import atomic_output
+from .guard import PVD_MARK, output_file, output_folder
 
 FORMATS = ("vtk", "csv")
 EXTRAS = {"vtk": ("meshio", "export")}  # format: (module it needs, pip extra that installs it)
@@ -108,18 +109,18 @@ def export(traj, fmt: str, out: str | Path | None = None, start: float | None = 
         raise ExportError(str(exc)) from None
     began = time.perf_counter()
     if fmt == "vtk":
-        path, files = _vtk(traj, out, library, frames)
+        path, files = _vtk(traj, output_folder(out, "vtk"), library, frames)
     else:
-        if out.is_dir():
-            raise ExportError(f"--out {out}: is a folder; give a file name")
-        files = [out]
-        with atomic_output(out) as tmp:
+        real = output_file(out)
+        tables = [] if traj.tension is None else [(output_file(history_path(real)), _history),
+                                                   (output_file(range_path(real)), _range)]
+        files = [real]
+        with atomic_output(real) as tmp:
             _csv(traj, tmp, frames)
-        if traj.tension is not None:
-            for table, write in ((history_path(out), _history), (range_path(out), _range)):
-                with atomic_output(table) as tmp:
-                    write(traj, tmp, frames)
-                files.append(table)
+        for table, write in tables:
+            with atomic_output(table) as tmp:
+                write(traj, tmp, frames)
+            files.append(table)
         path = out
     return Exported(path=path, files=len(files), bytes=sum(f.stat().st_size for f in files),
                     seconds=time.perf_counter() - began, frames=frames.stop - frames.start)
@@ -194,11 +195,11 @@ def _range(traj, path: Path, window: slice) -> None:
 
 
 def _vtk(traj, out: Path, meshio, window: slice) -> tuple[Path, list[Path]]:
-    """One .vtu per frame and a .pvd listing them, built in a temporary folder and moved into place whole."""
+    """One .vtu per frame and a .pvd listing them, built in a temporary folder and moved into place whole
+    (``out``: missing, empty, or an earlier export, as :func:`ropesim.io.guard.output_folder` checked)."""
     from xml.sax.saxutils import quoteattr
 
-    if out.exists() and not out.is_dir():
-        raise ExportError(f"--out {out}: exists and is not a folder; vtk writes a folder of files")
+    out = Path(os.path.abspath(out))     # "." and ".." by name, so the temporary folder goes beside it
     _, nodes, dim = traj.x.shape
     segments = np.column_stack([np.arange(nodes - 1), np.arange(1, nodes)])
     if traj.scene.rope.closed:
@@ -231,20 +232,42 @@ def _vtk(traj, out: Path, meshio, window: slice) -> tuple[Path, list[Path]]:
                 meshio.write(tmp / file, points, file_format="vtu")
                 entries.append(f'    <DataSet timestep="{when!r}" part="1" file={quoteattr(file)}/>')
         (tmp / f"{name}.pvd").write_text(
-            '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
+            f'<?xml version="1.0"?>\n{PVD_MARK}\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
             + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n", encoding="utf-8")
         os.chmod(tmp, 0o777 & ~_umask())
-        old = None
-        if out.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=out.parent))
-            os.replace(out, old / out.name)
-        os.replace(tmp, out)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
+        _put_in_place(tmp, out)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return out / f"{name}.pvd", sorted(out.iterdir())
+
+
+def _put_in_place(tmp: Path, out: Path) -> None:
+    """Move the new series ``tmp`` to ``out``: renamed over an empty folder or none, swapped with an earlier
+    export (which then goes); where a folder cannot be renamed (the current folder, a mount point) the earlier
+    export's files are removed and the new ones moved in."""
+    in_place = out.is_dir() and (out == Path.cwd() or os.path.ismount(out))   # a shell may stand in it
+    if out.is_dir() and not in_place and not os.listdir(out):
+        out.rmdir()
+    if not out.exists():
+        os.replace(tmp, out)
+        return
+    old = None if in_place else Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=out.parent))
+    try:
+        if old is None:
+            raise OSError("in place")
+        os.replace(out, old / out.name)
+    except OSError:                      # every file there is ropesim's (the guard checked): replaced in place
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+        for entry in os.listdir(out):
+            (out / entry).unlink()
+        for entry in os.listdir(tmp):
+            os.replace(tmp / entry, out / entry)
+        shutil.rmtree(tmp, ignore_errors=True)
+        return
+    os.replace(tmp, out)
+    shutil.rmtree(old, ignore_errors=True)
 
 
 def _umask() -> int:

@@ -15,13 +15,22 @@ The folder lies under the first writable of the package's ``__pycache__/kernels`
 Windows) and a per-user folder in the temporary directory; the most recently used few are kept, older
 ones deleted. It never imports numba, and the fingerprint (a stat per source file) costs well under a
 millisecond.
+
+Numba's cache index files are pickles, loaded as the user who runs ropesim: whoever can write the cache folder
+can run code as that user. So, as OpenSSH checks the folders of its keys: the kernel folder and the folder
+above it are made with mode 0700, and one that exists is used only when it is a real folder (not a link),
+owned by this user and not writable by group or others; else the next place is tried. The temporary
+directory's name is predictable (another user may have made it first): when it fails the check a private
+folder made by ``mkdtemp`` (removed at exit) serves this process, and one line on stderr says why.
 """
 
 from __future__ import annotations
 
+import atexit
 import hashlib
 import os
 import shutil
+import stat
 import sys
 import tempfile
 from pathlib import Path
@@ -38,6 +47,42 @@ def writable(folder: Path) -> bool:
     except OSError:
         return False
     return True
+
+
+def untrusted(folder: Path) -> str:
+    """Why ``folder`` must not hold compiled kernels (pickles loaded as this user), or "" when it may: it must be
+    a real folder (not a link), owned by this user, and not writable by group or others."""
+    if not hasattr(os, "getuid"):   # Windows: a user's folders are private by their access lists
+        return ""
+    st = os.lstat(folder)
+    if stat.S_ISLNK(st.st_mode):
+        return "it is a symbolic link"
+    if not stat.S_ISDIR(st.st_mode):
+        return "it is not a folder"
+    if st.st_uid != os.getuid():
+        return f"it belongs to another user (uid {st.st_uid})"
+    if st.st_mode & 0o022:
+        return f"others can write to it (mode {stat.S_IMODE(st.st_mode):o}; chmod go-w {folder})"
+    return ""
+
+
+def private_folder(base: Path, name: str) -> tuple[Path | None, str]:
+    """(``base/name``, "") once both are made (mode 0700) or checked (:func:`untrusted`) and a file can be
+    created in it; (None, why) when one fails the check; (None, "") when it cannot be written."""
+    try:
+        base.parent.mkdir(parents=True, exist_ok=True)
+        for folder in (base, base / name):
+            try:
+                os.mkdir(folder, 0o700)
+            except FileExistsError:
+                pass
+            why = untrusted(folder)
+            if why:
+                return None, f"{folder}: {why}"
+        tempfile.TemporaryFile(dir=base / name).close()
+    except OSError:
+        return None, ""
+    return base / name, ""
 
 
 def user_cache_dir() -> Path | None:
@@ -91,10 +136,24 @@ def choose_cache_dir(package_dir: Path = PACKAGE_DIR, environ=os.environ) -> str
     if environ.get("NUMBA_CACHE_DIR"):
         return None
     fingerprint = source_fingerprint(package_dir)
+    refused = ""
     for base in (package_dir / "__pycache__" / "kernels", user_cache_dir(), temp_cache_dir()):
-        if base is not None and writable(base / fingerprint):
-            prune(base, base / fingerprint)
-            return str(base / fingerprint)
+        if base is None:
+            continue
+        folder, why = private_folder(base, fingerprint)
+        if folder is not None:
+            prune(base, folder)
+            return str(folder)
+        refused = why or refused
+    if refused:   # the predictable temporary folder (or another) was not safe: a private one for this process
+        try:
+            folder = Path(tempfile.mkdtemp(prefix="ropesim-kernels-"))
+        except OSError:
+            return None
+        atexit.register(shutil.rmtree, folder, ignore_errors=True)
+        sys.stderr.write(f"ropesim: warning: not using the compile cache {refused}; kernels compile into "
+                         f"{folder} for this run only\n")
+        return str(folder)
     return None
 
 

@@ -46,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .atomic import FILE_MODE, _umask, atomic_output, fsync_path, write_json_atomic
+from .atomic import FILE_MODE, TEMPORARY_NAME, _umask, atomic_output, fsync_path, write_json_atomic
 
 FORMAT = "ropesim run folder 2"
 MANIFEST, LOCK, CHECKPOINT, STATE = "manifest.json", ".lock", "checkpoint", "state.npz"
@@ -366,16 +366,6 @@ def memmap_npz(path: Path, verify: bool = True) -> dict[str, np.ndarray]:
 # ----------------------------------------------------------------------------------------- the writer
 
 
-def looks_like_a_run(folder: Path) -> bool:
-    """True for an empty folder or one that holds a ropesim run (anything ropesim writes, or a leftover)."""
-    entries = os.listdir(folder)
-    if not entries:
-        return True
-    if any(name in RUN_MARKERS for name in entries):
-        return True
-    return all(name.startswith(".") for name in entries)  # only a lock, .frames-* or temporary files left
-
-
 def _exchange(a: Path, b: Path) -> None:
     """Swap two paths atomically (Linux renameat2 RENAME_EXCHANGE); OSError where it is not available."""
     try:
@@ -386,6 +376,32 @@ def _exchange(a: Path, b: Path) -> None:
     if fn(-100, os.fsencode(str(a)), -100, os.fsencode(str(b)), 2) != 0:
         e = ctypes.get_errno()
         raise OSError(e, os.strerror(e), str(a))
+
+
+def _remove_own_temporaries(folder: Path) -> None:
+    """Remove the temporary files of a run's own files (a writer killed during its final write leaves
+    ``.trajectory.XXXXXXXX.tmp.npz``, up to the trajectory's size); called with the folder's lock held."""
+    own = {Path(name).stem for name in (TRAJECTORY, LEDGER, STATE, SUMMARY, MANIFEST, SCENE)}
+    for entry in os.listdir(folder):
+        match = TEMPORARY_NAME.match(entry)
+        if match and match.group(1) in own:
+            (folder / entry).unlink(missing_ok=True)
+
+
+def _can_exchange(beside: Path) -> bool:
+    """True when this file system swaps two folders atomically (tried on two empty ones beside ``beside``)."""
+    a = b = None
+    try:
+        a = Path(tempfile.mkdtemp(prefix=f"{beside.name}.x-", dir=beside.parent))
+        b = Path(tempfile.mkdtemp(prefix=f"{beside.name}.y-", dir=beside.parent))
+        _exchange(a, b)
+        return True
+    except OSError:
+        return False
+    finally:
+        for path in (a, b):
+            if path is not None:
+                _remove_tree(path)
 
 
 def _remove_tree(path: Path) -> None:
@@ -420,24 +436,26 @@ class RunWriter:
     @classmethod
     def create(cls, folder: Path, scene_toml: str, specs: dict[str, tuple], grid: dict,
                command: str = "") -> "RunWriter":
-        """A new run in ``folder`` (``grid``: what the manifest records about it: scene name, time grid)."""
-        folder = Path(folder)
-        if folder.exists() and not folder.is_dir():
-            raise RunFolderError(f"{folder}: exists and is not a folder")
+        """A new run in ``folder`` (``grid``: what the manifest records about it: scene name, time grid).
+
+        ``folder`` must be missing, empty or a run folder holding nothing but ropesim's files
+        (:func:`ropesim.io.guard.output_folder`; a link is followed). An earlier run there stays whole until
+        the new one commits its first checkpoint past t = 0 (:meth:`checkpoint`): the new run is built beside
+        it and swapped in then, so a rerun killed or stopped before that leaves the earlier run as it was.
+        """
+        from .guard import WriteRefused, is_run_folder, output_folder
+
+        try:
+            folder = output_folder(folder, "run")
+        except WriteRefused as exc:
+            raise RunFolderError(str(exc)) from None
         old_lock = None
         if folder.is_dir():
-            if not looks_like_a_run(folder):
-                raise RunFolderError(f"{folder}: exists and is not a run folder (it holds "
-                                     f"{', '.join(sorted(os.listdir(folder))[:3])}, ...); a run replaces its "
-                                     f"folder whole, so choose another --out or empty it")
             old_lock = FolderLock.acquire(folder, command)
         try:
             _clean_leftovers(folder)
             folder.parent.mkdir(parents=True, exist_ok=True)
-            swapped = False
-            if old_lock is not None and not _same_device(folder, folder.parent):
-                pass  # a mount point (or the like): replaced in place below
-            else:
+            if old_lock is None or _same_device(folder, folder.parent):   # else a mount point: in place below
                 staging = None
                 try:
                     staging = Path(tempfile.mkdtemp(prefix=f".{folder.name}.new-", dir=folder.parent))
@@ -447,30 +465,22 @@ class RunWriter:
                     if staging is not None:
                         _remove_tree(staging)
                     staging = None
+                if staging is not None and old_lock is not None and not _can_exchange(staging):
+                    lock.release()
+                    _remove_tree(staging)
+                    staging = None
                 if staging is not None:
                     try:
-                        writer = cls._build(staging, folder, lock, scene_toml, specs, grid)
-                        if old_lock is None:
-                            os.rename(staging, folder)      # replaces an empty folder too (none here)
-                        else:
-                            _exchange(staging, folder)
-                        swapped = True
-                    except OSError as exc:
+                        writer = cls._build(staging, staging, lock, scene_toml, specs, grid)
+                    except BaseException:
                         lock.release()
                         _remove_tree(staging)
-                        if exc.errno not in (errno.ENOSYS, errno.EINVAL, errno.EXDEV, errno.EBUSY, errno.EPERM,
-                                             errno.EACCES, errno.ENOTEMPTY, errno.EEXIST):
-                            raise
-                    if swapped:
-                        for stream in writer.streams.values():
-                            stream.path = folder / CHECKPOINT / stream.path.name
-                        lock.path = folder / LOCK
-                        fsync_path(folder.parent)
-                        if old_lock is not None:
-                            old_lock.release()
-                            old_lock = None
-                            _remove_tree(staging)           # the old run, swapped out
-                        return writer
+                        raise
+                    writer.target, writer.earlier = folder, old_lock
+                    if old_lock is None or not is_run_folder(folder):
+                        writer.swap()        # nothing there to keep (a new or empty folder): in place at once
+                    old_lock = None
+                    return writer
             # In place: the old folder's own lock is held; clear it, the manifest first so that it stops
             # claiming to be a run, then build the new run inside.
             if old_lock is None:
@@ -482,7 +492,52 @@ class RunWriter:
             return writer
         finally:
             if old_lock is not None:
-                old_lock.release()
+                old_lock.release(remove=True)
+
+    target: Path | None = None        # where the run goes once swapped in (None: it is there already)
+    earlier: FolderLock | None = None  # the lock of the earlier run kept there until the swap
+
+    @property
+    def pending(self) -> bool:
+        """True while the run is still built beside its folder (an earlier run there is kept until the swap)."""
+        return self.target is not None
+
+    def swap(self) -> None:
+        """Move the run from beside its folder into it: renamed in (a new or empty folder), or exchanged with the
+        earlier run in one atomic ``renameat2``, which then goes. The streams' open files move with it."""
+        if self.target is None:
+            return
+        staging, folder = self.folder, self.target
+        if self.earlier is None and folder.is_dir() and not os.listdir(folder):
+            folder.rmdir()
+        if self.earlier is None and not folder.exists():
+            os.rename(staging, folder)
+        else:
+            _exchange(staging, folder)
+        self.folder, self.target = folder, None
+        for stream in self.streams.values():
+            stream.path = folder / CHECKPOINT / stream.path.name
+        self.lock.path = folder / LOCK
+        fsync_path(folder.parent)
+        if self.earlier is not None:
+            self.earlier.release()
+            self.earlier = None
+            _remove_tree(staging)           # the earlier run, swapped out
+
+    def discard(self) -> Path:
+        """Drop a run that was never swapped in (stopped before its first checkpoint past t = 0): the earlier
+        run stays as it was. Returns the folder that holds it."""
+        folder = self.target
+        self.close_streams()
+        if self.lock is not None:
+            self.lock.release()
+            self.lock = None
+        _remove_tree(self.folder)
+        if self.earlier is not None:
+            self.earlier.release(remove=True)
+            self.earlier = None
+        self.folder, self.target = folder, None
+        return folder
 
     @classmethod
     def _build(cls, where: Path, folder: Path, lock: FolderLock, scene_toml: str, specs: dict, grid: dict):
@@ -513,18 +568,27 @@ class RunWriter:
     @classmethod
     def reopen(cls, folder: Path, command: str = "") -> "RunWriter":
         """Lock ``folder`` and open its run to continue from the last checkpoint (see :func:`resume_plan`)."""
-        folder = Path(folder)
+        from .guard import WriteRefused, follow
+
+        shown = Path(folder)
+        try:
+            folder = follow(shown, "--resume")
+        except WriteRefused as exc:
+            raise RunFolderError(str(exc)) from None
         if not folder.is_dir():
-            raise RunFolderError(f"{folder}: no such run folder")
+            raise RunFolderError(f"{shown}: no such run folder")
+        if read_manifest(folder) is None:    # before the lock: a folder that is no run is left as it was
+            raise RunFolderError(f"{shown}: has no manifest.json (not a run folder, or written by an older "
+                                 f"ropesim), so it cannot be resumed; run the scene again")
         lock = FolderLock.acquire(folder, command)
         try:
             manifest = read_manifest(folder)
             if manifest is None:
-                raise RunFolderError(f"{folder}: has no manifest.json (written by an older ropesim, or not a run "
-                                     f"folder), so it cannot be resumed; run the scene again")
+                raise RunFolderError(f"{shown}: has no manifest.json, so it cannot be resumed; run the scene again")
+            _remove_own_temporaries(folder)
             return cls(folder, lock, manifest, {})
         except BaseException:
-            lock.release()
+            lock.release(remove=True)
             raise
 
     # -- continuing -------------------------------------------------------------------------------------
@@ -639,6 +703,10 @@ class RunWriter:
 
     def disk_full(self, needed: int, what: str = "the rest of the run") -> DiskFull:
         cp = self.manifest.get("checkpoint")
+        if self.pending:
+            return DiskFull(f"{self.target}: the disk is full: writing {what} needs about {human(needed)} and "
+                            f"{human(free_bytes(self.folder))} is free; the new run is dropped and the earlier run "
+                            f"in {self.target} is kept as it was")
         kept = (f"every frame up to the last checkpoint (t = {cp['t']:.6g} s, {cp['frames']} frames) is kept in "
                 f"{self.folder}; free some space and `ropesim run --resume {self.folder}` continues it"
                 if cp else f"nothing was checkpointed yet in {self.folder}")
@@ -668,6 +736,8 @@ class RunWriter:
         old, self.state_file = self.state_file, name
         if old and old != name:
             (self.folder / old).unlink(missing_ok=True)
+        if self.pending and t > 0:
+            self.swap()      # the new run has frames of its own now: it takes the earlier run's place
 
     def arrays(self) -> dict[str, np.ndarray]:
         """Every frame written so far, memory-mapped read-only (for the summary)."""
@@ -680,6 +750,7 @@ class RunWriter:
                message: str = "") -> None:
         """A finished run: write ``files`` (name -> arrays, as npz), the final state and the summary, then commit
         the manifest with ``status``; the checkpoint streams go."""
+        self.swap()
         try:
             for name, arrays in files.items():
                 write_npz_atomic(self.folder / name, arrays)
@@ -701,7 +772,11 @@ class RunWriter:
         fsync_path(self.folder)
 
     def mark(self, status: str, message: str, summary: dict | None = None) -> None:
-        """Record how an unfinished run stopped (interrupted) beside its last checkpoint; the summary first."""
+        """Record how an unfinished run stopped (interrupted) beside its last checkpoint; the summary first. A
+        run stopped before it replaced an earlier run is dropped instead (:meth:`discard`)."""
+        if self.pending:
+            self.discard()
+            return
         if summary is not None:
             write_json_atomic(self.folder / SUMMARY, summary)
         self.manifest["status"], self.manifest["message"] = status, message
@@ -712,6 +787,9 @@ class RunWriter:
             s.close()
 
     def close(self) -> None:
+        if self.pending:      # failed before it replaced the earlier run (a full disk, say): that one stays
+            self.discard()
+            return
         self.close_streams()
         if self.lock is not None:
             self.lock.release(remove=True)

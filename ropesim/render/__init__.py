@@ -14,5 +14,8 @@ matplotlib, Pillow and imageio-ffmpeg load only inside those modules.
 """
 
 
+SIZE_RANGE = (320, 8192)   # an animation's longer side [px]: no side is drawn shorter (framing.MIN_SIDE)
+
+
 class RenderError(ValueError):
     """A picture that cannot be made as asked; ``str()`` is one line naming the option and what is allowed."""

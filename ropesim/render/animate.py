@@ -8,6 +8,7 @@ follows the driven node the fixed geometry moves too, so it is redrawn with the 
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable, Iterator, Protocol
@@ -16,11 +17,11 @@ import numpy as np
 
 from ..model.build import Model, build
 from ..scene.schema import Scene
-from . import RenderError
+from . import SIZE_RANGE, RenderError
 from .encode import ANIMATION_TYPES, GIF_MAX_FPS, gif_fps, write_gif, write_mp4
 from .framing import Projection, figure_inches, followed_nodes, origin, projection, single_view, view_box
 from ..io.atomic import atomic_output
-from .output import output_type
+from .output import output_path
 from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
 from .style import with_picture_text
 from .timeline import animation_plan
@@ -115,9 +116,9 @@ def animate(traj: Frames, out: str | Path, *, fps: float = 25.0, speed: float = 
     Raises :class:`ropesim.render.RenderError` for a request that cannot be met, before writing anything.
     """
     out = Path(out)
-    kind = output_type(out, ANIMATION_TYPES)
-    if size < 128:
-        raise RenderError(f"--size {size}: must be at least 128 px")
+    real, kind = output_path(out, ANIMATION_TYPES)
+    if not 1 <= size <= SIZE_RANGE[1]:    # (the command line asks for at least SIZE_RANGE[0], what is drawn)
+        raise RenderError(f"--size {size}: must be a number of pixels from {SIZE_RANGE[0]} to {SIZE_RANGE[1]}")
     remarks = []
     rate = fps
     if kind == ".gif" and fps > 0:
@@ -133,17 +134,55 @@ def animate(traj: Frames, out: str | Path, *, fps: float = 25.0, speed: float = 
     for remark in remarks:
         if note is not None:
             note(remark)
+    check_memory(size * size, f"--size {size}")     # the picture is at most size x size px
     renderer = FrameRenderer(traj, model, proj, nodes, size)
     frames = _tracked((renderer.render(i) for i in plan.indices), len(plan.indices), f"encoding {out.name}",
                       progress)
-    with atomic_output(out) as tmp:
+    with atomic_output(real) as tmp:
         if kind == ".gif":
             spread = plan.indices[np.linspace(0, len(plan.indices) - 1, PALETTE_SAMPLES).round().astype(int)]
-            write_gif(frames, tmp, plan.fps, [renderer.render(i) for i in spread])
+            write_gif(frames, tmp, plan.fps, [_sample(renderer.render(i)) for i in spread])
         else:
             write_mp4(frames, tmp, plan.fps, renderer.size)
     played = gif_fps(plan.fps) if kind == ".gif" else plan.fps
     return Animation(path=out, frames=len(plan.indices), fps=played, size=renderer.size)
+
+
+BYTES_PER_PIXEL = 24   # the canvas, its saved background, the frame's copy, its RGB and palette images, the
+                       # previous frame, and the palette's pixel samples (measured: 1.2 GB at --size 8192)
+
+
+def check_memory(pixels: int, option: str) -> None:
+    """Refuse (before drawing anything) a picture whose frames would need more than half the free memory."""
+    needed = BYTES_PER_PIXEL * pixels
+    free = available_memory()
+    if free and needed > free / 2:
+        side = int((free / 2 / BYTES_PER_PIXEL) ** 0.5)
+        raise RenderError(f"{option}: a {pixels / 1e6:.3g} megapixel animation needs about {needed / 1e9:.2g} GB of "
+                          f"memory and {free / 1e9:.2g} GB is free; at most about {side} px a side here")
+
+
+def available_memory() -> int:
+    """Bytes of memory free for a new allocation (Linux: MemAvailable), or 0 when unknown."""
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (AttributeError, ValueError, OSError):
+        return 0
+
+
+def _sample(frame: np.ndarray) -> np.ndarray:
+    """A palette sample of a frame: its pixels (at most PALETTE_PIXELS, evenly strided) as (P, 1, 4)."""
+    from .encode import PALETTE_PIXELS
+
+    flat = frame.reshape(-1, frame.shape[-1])
+    return np.ascontiguousarray(flat[::max(1, len(flat) // PALETTE_PIXELS)])[:, None, :]
 
 
 def _tracked(frames: Iterable[np.ndarray], total: int, label: str, enabled: bool) -> Iterator[np.ndarray]:

@@ -11,14 +11,19 @@ of 16 (see :mod:`ropesim.render.framing`) so ffmpeg never rescales.
 
 from __future__ import annotations
 
+import errno
+import shutil
 from pathlib import Path
 from typing import Iterable
 
 import numpy as np
 
+from ..io.guard import SOFTWARE
+
 ANIMATION_TYPES = (".gif", ".mp4")
 GIF_MAX_FPS = 50.0  # viewers slow down GIFs with delays under 2/100 s
 PALETTE_SEPARATION = 9  # see gif_palette
+PALETTE_PIXELS = 1 << 20  # pixels of a sample frame the palette counts (a large frame's every k-th)
 MP4_QUALITY = 6     # imageio-ffmpeg's 0..10 scale (6 is x264's crf 20); thin lines need more than its default 5
 MP4_PRESET = "veryfast"  # x264 speed preset: at these sizes twice as fast as "medium", about as small
 
@@ -68,7 +73,7 @@ def write_gif(frames: Iterable[np.ndarray], path: Path, fps: float, samples: lis
     first = next(images)
     # optimize=False: Pillow's per-frame palette trimming halves the writing speed for files 15 % smaller
     first.save(path, format="GIF", save_all=True, append_images=images, loop=0, optimize=False,
-               duration=10 * round(100.0 / gif_fps(fps)))
+               duration=10 * round(100.0 / gif_fps(fps)), comment=SOFTWARE)
 
 
 def write_mp4(frames: Iterable[np.ndarray], path: Path, fps: float, size: tuple[int, int]) -> None:
@@ -78,10 +83,30 @@ def write_mp4(frames: Iterable[np.ndarray], path: Path, fps: float, size: tuple[
     writer = imageio_ffmpeg.write_frames(
         str(path), size, fps=fps, codec="libx264", pix_fmt_in="rgba", pix_fmt_out="yuv420p", quality=MP4_QUALITY,
         macro_block_size=16, ffmpeg_log_level="error",
-        output_params=["-preset", MP4_PRESET, "-fflags", "+bitexact", "-flags:v", "+bitexact", "-map_metadata", "-1"])
-    writer.send(None)
+        output_params=["-preset", MP4_PRESET, "-fflags", "+bitexact", "-flags:v", "+bitexact", "-map_metadata", "-1",
+                       "-metadata", f"comment={SOFTWARE}"])
     try:
-        for frame in frames:
-            writer.send(np.ascontiguousarray(frame))
-    finally:
-        writer.close()
+        writer.send(None)
+        try:
+            for frame in frames:
+                writer.send(np.ascontiguousarray(frame))
+        finally:
+            writer.close()
+    except (OSError, RuntimeError) as exc:
+        raise _ffmpeg_failure(exc, path) from None
+
+
+FULL_DISK_BYTES = 1 << 20   # less than this free where ffmpeg failed: the disk filled up
+
+
+def _ffmpeg_failure(exc: BaseException, path: Path) -> OSError:
+    """ffmpeg's failure as one OSError: a full disk as ENOSPC, else the last line ffmpeg said (imageio-ffmpeg
+    hands over its whole command line and log, a dozen lines)."""
+    try:
+        full = shutil.disk_usage(Path(path).parent).free < FULL_DISK_BYTES
+    except OSError:
+        full = False
+    if full or getattr(exc, "errno", None) in (errno.ENOSPC, errno.EDQUOT):
+        return OSError(errno.ENOSPC, "No space left on device")
+    said = [line.strip() for line in str(exc).splitlines() if line.strip() and not line.startswith("FFMPEG")]
+    return OSError(errno.EIO, f"ffmpeg failed: {said[-1] if said else type(exc).__name__}")

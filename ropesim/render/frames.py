@@ -17,8 +17,7 @@ from . import RenderError
 from ..model.build import build
 from ..io.trajectory import Trajectory
 from .framing import figure_inches, fit_box, followed_nodes, origin, projection, view_aspect, view_box
-from ..io.atomic import atomic_output
-from .output import output_type
+from .output import output_path, save_png
 from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
 from .style import OUTSIDE_RIGHT, with_picture_text
 from .timeline import chosen_frames
@@ -61,7 +60,7 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
     node; view: the projection of a 3-D scene; columns: panels per row; width: the picture's width [px].
     """
     out = Path(out)
-    output_type(out, (".png",))
+    real, _ = output_path(out, (".png",))
     indices = chosen_frames(traj.t, times, count)
     if columns is not None and columns < 1:
         raise RenderError(f"--columns {columns}: must be at least 1")
@@ -114,8 +113,7 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
     handles = legend_handles(model)
     if handles:
         fig.legend(handles=handles, loc="outside lower center", ncol=len(handles), frameon=False, fontsize=7)
-    with atomic_output(out) as tmp:
-        fig.savefig(tmp, format="png", dpi=DPI)
+    save_png(fig, real, DPI)
     return Sheet(path=out, times=tuple(shown), size=(px_width, px_height))
 
 

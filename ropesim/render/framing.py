@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import RenderError
+from . import SIZE_RANGE, RenderError
 from ..analysis.summary import FRAME_BLOCK, block_frames
 from ..model.build import Model
 
@@ -238,7 +238,7 @@ class Layout:
 PAD = {"left": 58, "right": 12, "bottom": 36, "top": 22}  # [px] room for tick labels and the title line
 LEGEND_LINE = 16  # [px] more at the top when there is a legend line under the title
 MACRO_BLOCK = 16  # picture sizes are whole multiples of this, so video encoders never rescale
-MIN_SIDE = 320    # [px] no side shorter, so the title and legend fit
+MIN_SIDE = SIZE_RANGE[0]   # [px] no side shorter, so the title and legend fit
 
 
 def single_view(box: np.ndarray, size: int, legend: bool = False) -> Layout:

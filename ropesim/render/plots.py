@@ -23,8 +23,7 @@ from ..model.build import Model, build
 from ..model.forces.springs import pair_spring_stretch
 from ..io.trajectory import Trajectory
 from .framing import figure_inches, frame_blocks
-from ..io.atomic import atomic_output
-from .output import output_type
+from .output import output_path, save_png
 from .style import OUTSIDE_RIGHT, with_picture_text
 
 DPI = 100
@@ -271,10 +270,9 @@ def plot_run(traj: Trajectory, out: str | Path, start: float | None = None, stop
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     out = Path(out)
-    output_type(out, (".png",))
+    real, _ = output_path(out, (".png",))
     fig, panels = run_figure(traj, start, stop)
     FigureCanvasAgg(fig)
-    with atomic_output(out) as tmp:
-        fig.savefig(tmp, format="png", dpi=DPI)
+    save_png(fig, real, DPI)
     width, height = (round(v) for v in fig.bbox.size)
     return Plot(path=out, panels=panels, size=(width, height))

@@ -16,6 +16,8 @@ import numpy as np
 from . import RenderError
 
 RELATIVE_SLACK = 1e-9  # requested times may miss the saved ones by this fraction of the run (rounding)
+MIN_FPS = 0.1          # a video frame shows for at most 10 s (a GIF's delay field holds at most 655 s; players
+                       # and ffmpeg refuse far slower rates)
 
 
 @dataclass(frozen=True)
@@ -74,6 +76,10 @@ def animation_plan(t: np.ndarray, fps: float, speed: float = 1.0, start: float |
     if interval > step * (1 + 1e-6) and len(t) > 1:
         inside = np.flatnonzero((t >= start - _slack(t)) & (t <= end + _slack(t)))
         rate = speed / interval
+        if rate < MIN_FPS:
+            raise RenderError(f"--speed {speed:g}: each saved frame (every {interval:.3g} s) would show for "
+                              f"{1 / rate:.3g} s; at most {1 / MIN_FPS:g} s: use --speed {MIN_FPS * interval:.3g} "
+                              f"or more")
         note = (f"the run saved a frame every {interval:.3g} s, too few for {fps:g} fps at speed {speed:g} "
                 f"(one every {step:.3g} s): using its {len(inside)} saved frames at {rate:.3g} fps "
                 f"(save more with --set output.interval={step:.3g})")

@@ -21,6 +21,11 @@ from .errors import SceneError
 MAX_STEPS = 1e12  # a run of more steps would take days; t_end / dt beyond it is a typo, not a plan
 MAX_MAGNITUDE = 1e12  # in SI units: 7 AU, 30 000 years, a 1e12 N/m spring; no rope scene needs more
 MIN_POSITIVE = 1e-12  # the least value of a quantity that must be > 0, so that ratios such as k / m stay finite
+MAX_SCENE_BYTES = 16 * 2 ** 20   # a scene file is a few kB; an inline path table of 100 000 rows about 5 MB
+MAX_TEXT = 1000       # characters of any text value (a description is one line)
+MAX_NAME_BYTES = 200  # a scene's name names its run folder; 255 bytes is the usual file-name limit
+MAX_PATH_ROWS = 100_000  # rows of a driven node's path (a 3-hour path every 0.1 s); scene.toml stores them
+BOM = "\ufeff"        # a UTF-8 byte-order mark, which some Windows editors put first; TOML does not allow it
 
 
 def load_scene(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> S.Scene:
@@ -30,6 +35,11 @@ def load_scene(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) ->
     path = found.path
     source = found.label
     try:
+        size = path.stat().st_size
+        if size > MAX_SCENE_BYTES and path.is_file():
+            raise SceneError(source, "", f"is {size / 1e6:.3g} MB; a scene file is at most "
+                                         f"{MAX_SCENE_BYTES / 1e6:.3g} MB (give a long driven path as a CSV "
+                                         f"file, driven.path)")
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise SceneError(source, "", "no such scene file") from None
@@ -44,11 +54,15 @@ def load_scene(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) ->
 def scene_from_toml(text: str, source: str = "<scene>", default_name: str = "scene",
                     overrides: list[str] | tuple[str, ...] = (), base_dir: str | Path | None = None) -> S.Scene:
     """Parse TOML text into a validated scene (see :func:`load_scene`); files it names (a driven node's
-    ``path``) are read relative to ``base_dir`` (default: the current folder)."""
+    ``path``) are read relative to ``base_dir`` (default: the current folder). A leading UTF-8 byte-order mark
+    is ignored; tables or arrays nested too deeply for Python's parser are refused in one line."""
     try:
-        raw = tomllib.loads(text)
+        raw = tomllib.loads(text.removeprefix(BOM))
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(source, "", f"not valid TOML: {exc}") from None
+    except RecursionError:
+        raise SceneError(source, "", "not a scene: its tables or arrays are nested too deeply to read (a scene "
+                                     "nests them a few levels)") from None
     for item in overrides:
         apply_override(raw, item, source)
     if overrides:
@@ -67,6 +81,8 @@ def parse_override(item: str, source: str = "--set") -> tuple[list[str], Any]:
         value = tomllib.loads(f"v = {text.strip()}")["v"]
     except tomllib.TOMLDecodeError:
         value = text.strip()
+    except RecursionError:
+        raise SceneError(source, "--set", f"{key}: the value is nested too deeply to read") from None
     return key.split("."), value
 
 
@@ -79,8 +95,8 @@ def apply_override(raw: dict, item: str, source: str = "--set") -> None:
         if isinstance(node, list):
             node = _list_item(node, part, here, source, item)
         elif isinstance(node, dict):
-            if part not in node:
-                node[part] = [{}] if part in S.ARRAYS_OF_TABLES and _is_index(parts[depth + 1]) else {}
+            if part not in node:   # an empty list: its entry 0 is added below, so counts stay true
+                node[part] = [] if part in S.ARRAYS_OF_TABLES and _is_index(parts[depth + 1]) else {}
             node = node[part]
         else:
             raise SceneError(source, here, f"is a value, not a table, so --set {item} cannot go inside it")
@@ -108,8 +124,11 @@ def _list_item(items: list, part: str, here: str, source: str, item: str):
     if index == len(items):
         items.append({})
     if index > len(items):
-        raise SceneError(source, here, f"has {len(items)} entries; --set can change one of them or add entry "
-                                       f"{len(items)}")
+        n, base = len(items), here.rpartition(".")[0]
+        have = (f"has no entries; --set can add {base}.0" if n == 0 else
+                f"has 1 entry; --set can change {base}.0 or add {base}.1" if n == 1 else
+                f"has {n} entries; --set can change {base}.0 to {base}.{n - 1} or add {base}.{n}")
+        raise SceneError(source, here, have)
     return items[index]
 
 
@@ -255,7 +274,11 @@ def _read_path(name: str, base_dir: Path, scene: S.Scene, key: str, fail) -> tup
     path = Path(name)
     path = path if path.is_absolute() else (base_dir / path)
     try:
-        text = path.read_text(encoding="utf-8")
+        size = path.stat().st_size
+        if size > MAX_SCENE_BYTES and path.is_file():
+            fail(key, f"{path} is {size / 1e6:.3g} MB; a path is at most {MAX_PATH_ROWS:,} rows "
+                      f"({MAX_SCENE_BYTES / 1e6:.3g} MB): resample it")
+        text = path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
         fail(key, f"cannot read {path} ({exc.__class__.__name__})")
     columns = scene.dimension + 1
@@ -263,6 +286,9 @@ def _read_path(name: str, base_dir: Path, scene: S.Scene, key: str, fail) -> tup
     for number, row in enumerate(csv.reader(text.splitlines()), start=1):
         if not row or row[0].lstrip().startswith("#"):
             continue
+        if len(rows) == MAX_PATH_ROWS:
+            fail(key, f"{path}: more than {MAX_PATH_ROWS:,} rows; a path is at most that many (the run folder's "
+                      f"scene.toml keeps them): resample it")
         try:
             values = [float(v) for v in row]
         except ValueError:
@@ -272,6 +298,9 @@ def _read_path(name: str, base_dir: Path, scene: S.Scene, key: str, fail) -> tup
         if len(values) != columns or not all(math.isfinite(v) for v in values):
             fail(key, f"{path}, line {number}: needs {columns} finite numbers (t, dx, dy{', dz' if columns == 4 else ''}), "
                       f"got {_show(row)}")
+        if any(abs(v) > MAX_MAGNITUDE for v in values):
+            fail(key, f"{path}, line {number}: numbers must be at most {MAX_MAGNITUDE:g} in magnitude (s, m), as "
+                      f"in a scene file; got {_show(row)}")
         rows.append(tuple(values))
     _check_path(rows, scene, key, f"{path}: ", fail)
     return tuple(rows)
@@ -460,6 +489,9 @@ def _check_name_and_length(scene: S.Scene, fail) -> None:
     if not name or name in (".", "..") or "/" in name or "\\" in name or not name.isprintable():
         fail("name", f"must be a plain folder name (runs go to runs/<name>/): printable, without / or \\, "
                      f"not '.' or '..'; got {_show(name)}")
+    if len(name.encode("utf-8")) > MAX_NAME_BYTES:
+        fail("name", f"must be at most {MAX_NAME_BYTES} bytes in UTF-8 (it names the run folder), got "
+                     f"{len(name.encode('utf-8'))}")
     steps = scene.integrator.t_end / scene.integrator.dt
     if steps > MAX_STEPS:
         fail("integrator.t_end", f"t_end / dt = {steps:.3g} steps; at most {MAX_STEPS:.0e} are allowed "
@@ -638,6 +670,8 @@ def _value(value: Any, sp: S.Spec, key: str, source: str, dim: int):
     if sp.kind == "str":
         if not isinstance(value, str):
             bad(f"must be one of {_choices(sp.choices)}" if sp.choices else "must be a string")
+        if len(value) > MAX_TEXT:
+            raise SceneError(source, key, f"must be at most {MAX_TEXT} characters, got {len(value):,}")
         if sp.choices and value not in sp.choices:
             near = difflib.get_close_matches(value, sp.choices, n=1)
             hint = f" (did you mean '{near[0]}'?)" if near else ""
@@ -685,6 +719,11 @@ def _value(value: Any, sp: S.Spec, key: str, source: str, dim: int):
                 isinstance(v, (int, float)) and not isinstance(v, bool) and _finite(v) for v in row) for row in value)
         if not ok:
             bad(f"must be a list of rows, each {dim + 1} finite numbers (t, then one per axis)")
+        if len(value) > MAX_PATH_ROWS:
+            raise SceneError(source, key, f"must be at most {MAX_PATH_ROWS:,} rows, got {len(value):,}")
+        for row in value:
+            for v in row:
+                _magnitude(float(v), sp, key, source, shown=row)
         return tuple(tuple(float(v) for v in row) for row in value)
     raise AssertionError(sp.kind)
 

@@ -29,7 +29,7 @@ import os
 from contextlib import closing
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable
+from typing import Callable, Iterable
 
 from ..io.atomic import write_text_atomic
 from ..io.runfolder import SUMMARY
@@ -41,6 +41,7 @@ RESULTS = "results.csv"
 FIXED_COLUMNS = ("run", "status", "error")
 TIMING_COLUMNS = ("wall_time_s", "compile_time_s", "steps_per_second", "node_steps_per_second")
 ERROR = "error"  # status of a run whose process raised instead of returning a summary
+NOT_RUN = "not_run"  # status of a run the sweep never started (it was stopped first)
 
 
 @dataclass
@@ -58,7 +59,11 @@ class SweepResult:
 
     @property
     def failed(self) -> list[dict]:
-        return [r for r in self.rows if r["status"] != "completed"]
+        return [r for r in self.rows if r["status"] not in ("completed", NOT_RUN)]
+
+    @property
+    def not_run(self) -> int:
+        return sum(r["status"] == NOT_RUN for r in self.rows)
 
 
 # ---------------------------------------------------------------------------------------- table
@@ -111,44 +116,58 @@ def read_table(path: str | Path) -> list[dict]:
 
 
 def run_sweep(scene_file: str | Path, sets: list[str], out: str | Path | None = None, jobs: int | None = None,
-              scheduler: str | None = None, plots: Iterable[str] = (), quiet: bool = False) -> SweepResult:
+              scheduler: str | None = None, plots: Iterable[str] = (), quiet: bool = False,
+              before: Callable[[int, Path], None] | None = None) -> SweepResult:
     """Run the sweep (see the module doc) and return its rows; raises :class:`SweepError` on bad input.
 
     Runs go to ``jobs`` local processes (default: one per core), or to the Dask scheduler at ``scheduler``.
-    A Ctrl-C stops the sweep after the runs in progress have stopped cleanly; the table is written anyway.
+    ``before(count, folder)`` is called once the number of runs and the sweep folder are known, before the
+    combinations are resolved (the command line says them, and asks before a large sweep). A Ctrl-C stops
+    the sweep after the runs in progress have stopped cleanly; the table is written anyway (OSError if it
+    cannot be: a full disk).
     """
+    from ..io.guard import WriteRefused, output_folder
+    from .plan import parse_axes
+    from .progress import PLANNING_SHOWN, planning
+
     plots = list(plots)
     if jobs is not None and jobs < 1:
         raise SweepError(f"--jobs {jobs}: must be at least 1")
-    base, axes, points = plan(scene_file, sets)
-    swept = [a.key for a in axes if a.swept]
+    axes = parse_axes(sets)
     if plots and not any(_numeric_axis(a) for a in axes if a.swept):
         raise SweepError("--plot needs a swept parameter with numeric values (give a --set KEY with several "
                          "numbers)")
-    root = Path(out) if out is not None else Path("runs") / f"sweep-{base.name}"
-    if root.exists() and not root.is_dir():
-        raise SweepError(f"--out {root}: exists and is not a folder")
+    root = Path(out) if out is not None else Path("runs") / f"sweep-{_base_name(scene_file, axes)}"
+    try:
+        root = output_folder(root, "sweep")
+    except WriteRefused as exc:
+        raise SweepError(str(exc)) from None
+    count = math.prod(len(a.values) for a in axes)
+    if before is not None and count >= PLANNING_SHOWN:    # a large sweep is said (and asked) before it plans
+        before(count, root)
+    with planning(count, quiet) as on_point:
+        base, axes, points = plan(scene_file, sets, on_point=on_point)
+    if before is not None and count < PLANNING_SHOWN:     # a small one once every combination is valid
+        before(count, root)
+    swept = [a.key for a in axes if a.swept]
 
-    folders = {p.name: root / p.name for p in points}
+    folders = {p.name: root / p.name for p in points}   # each made by its run (none for runs never started)
     done = {p.name for p in points if is_finished(folders[p.name], p.scene_toml)}
     todo = [(p, folders[p.name]) for p in points if p.name not in done]
-    try:
-        for _, folder in todo:   # (a run killed midway never looks finished: its manifest says incomplete)
-            folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise SweepError(f"--out {root}: cannot write the run folders ({exc.strerror or exc})") from None
 
     outcomes: dict[str, Outcome] = {}
-    result = SweepResult(rows=[], csv_path=root / RESULTS, swept=swept, skipped=len(done), ran=len(todo))
+    result = SweepResult(rows=[], csv_path=root / RESULTS, swept=swept, skipped=len(done))
     from .progress import SweepProgress
 
     stopped = None
     workers = min(jobs or os.cpu_count() or 1, len(todo))
-    if workers > 1 and scheduler is None:
-        try:
+    try:
+        if workers > 1 and scheduler is None:
             warm_up([p for p, _ in todo])
-        except (KeyboardInterrupt, Stopped) as exc:
-            stopped = exc
+        if plots and todo:
+            _check_figures_early(todo[0][0], plots, axes, root)
+    except (KeyboardInterrupt, Stopped) as exc:
+        stopped = exc
     with SweepProgress(len(points), quiet) as progress:
         progress.skipped(len(done), root)
         try:
@@ -170,6 +189,7 @@ def run_sweep(scene_file: str | Path, sets: list[str], out: str | Path | None = 
             result.stopped_by = exc.name if isinstance(exc, Stopped) else "SIGINT"
         finally:
             result.rows = [_final_row(p, folders[p.name], outcomes.get(p.name)) for p in points]
+            result.ran = sum(r["status"] != NOT_RUN for r in result.rows) - len(done)
             root.mkdir(parents=True, exist_ok=True)
             write_table(result.rows, swept, result.csv_path)
     if not result.interrupted:
@@ -207,14 +227,48 @@ def warm_up(points: list[Point]) -> None:
 
 
 def _final_row(point: Point, folder: Path, outcome: Outcome | None) -> dict:
-    """The row of a point: from the run just done, or from its folder (a finished run kept on resume)."""
+    """The row of a point: from the run just done, from its folder (a finished run kept on resume), or, for a
+    run the sweep never started (it was stopped first), status not_run."""
     if outcome is not None:
         return make_row(*outcome)
     try:
         summary = json.loads((folder / SUMMARY).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return make_row(point, None, "not run (the sweep was interrupted first)")
+        if not isinstance(summary, dict):
+            raise ValueError
+    except (OSError, ValueError, RecursionError):
+        return {"run": point.name, **point.params, "status": NOT_RUN, "error": ""}
     return make_row(point, summary, "")
+
+
+def _base_name(scene_file: str | Path, axes) -> str:
+    """The scene's name with the sweep's single values applied (it names the default sweep folder)."""
+    from ..scene.loader import SceneError, load_scene
+
+    fixed = [f"{a.key}={toml_value(a.values[0])}" for a in axes if not a.swept]
+    try:
+        return load_scene(scene_file, fixed).name
+    except SceneError as exc:
+        raise SweepError(str(exc)) from None
+
+
+def _check_figures_early(point: Point, plots: list[str], axes, root: Path) -> None:
+    """Refuse an unknown --plot FIGURE before any run: the summary columns of a one-step run of the first
+    combination (in memory, a fraction of a second once its kernel is compiled)."""
+    from dataclasses import replace
+
+    from ..run import simulate
+    from .points import scene_from_toml
+
+    try:
+        scene = scene_from_toml(point.scene_toml)
+        probe = simulate(replace(scene, integrator=replace(scene.integrator, t_end=scene.integrator.dt)))
+    except Exception:
+        return    # the run itself will say what is wrong with it
+    row = make_row(point, probe.summary, "")
+    from .plot import check_figure
+
+    for figure in plots:
+        check_figure([row], axes, figure, root)
 
 
 def number(value: str) -> float:

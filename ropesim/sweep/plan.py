@@ -9,6 +9,7 @@ a bad key or value stops the sweep with one line (:class:`SweepError`).
 from __future__ import annotations
 
 import itertools
+import math
 import re
 import tomllib
 from dataclasses import dataclass, fields
@@ -62,7 +63,10 @@ def parse_axis(item: str) -> Axis:
 
 
 def _toml(text: str) -> Any:
-    return tomllib.loads(f"v = {text}")["v"]
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except RecursionError:
+        raise SweepError(f"--set value {text[:40]}...: nested too deeply to read") from None
 
 
 def _is_number(value) -> bool:
@@ -173,18 +177,32 @@ def _folder_names(axes: list[Axis], combos: list[tuple]) -> list[str]:
 # ------------------------------------------------------------------------------------- planning
 
 
-def plan(scene_file: str | Path, sets: list[str]) -> tuple[S.Scene, list[Axis], list[Point]]:
-    """Parse the ``--set`` items and resolve every combination to a scene; raises :class:`SweepError`.
+MAX_RUNS = 100_000   # combinations in one sweep; more is a typo in a range (or a week of computing): split it
 
-    Returns the scene with the single values applied, the axes in the order given, and one point per
-    combination in product order (the first key varies slowest).
-    """
+
+def parse_axes(sets: list[str]) -> list[Axis]:
+    """The ``--set`` items as axes, each key once, at most MAX_RUNS combinations; raises :class:`SweepError`."""
     axes = [parse_axis(item) for item in sets]
     seen = set()
     for axis in axes:
         if axis.key in seen:
             raise SweepError(f"--set {axis.key}: given twice; list all its values in one --set")
         seen.add(axis.key)
+    count = math.prod(len(a.values) for a in axes)
+    if count > MAX_RUNS:
+        raise SweepError(f"--set: {count:,} combinations; a sweep runs at most {MAX_RUNS:,} (split it into several "
+                         f"sweeps, or use fewer values)")
+    return axes
+
+
+def plan(scene_file: str | Path, sets: list[str], on_point=None) -> tuple[S.Scene, list[Axis], list[Point]]:
+    """Parse the ``--set`` items and resolve every combination to a scene; raises :class:`SweepError`.
+
+    Returns the scene with the single values applied, the axes in the order given, and one point per
+    combination in product order (the first key varies slowest). ``on_point(i, n)`` is told of each point
+    resolved (planning 10^4 points takes seconds).
+    """
+    axes = parse_axes(sets)
     fixed = [f"{a.key}={toml_value(a.values[0])}" for a in axes if not a.swept]
     try:
         base = load_scene(scene_file, fixed)
@@ -205,6 +223,8 @@ def plan(scene_file: str | Path, sets: list[str]) -> tuple[S.Scene, list[Axis], 
             raise SweepError(str(exc)) from None
         params = {a.key: v for a, v in zip(axes, combo) if a.swept}
         points.append(Point(name=name, params=params, sets=sets_here, scene_toml=scene_to_toml(scene)))
+        if on_point is not None:
+            on_point(len(points), len(combos))
     return base, axes, points
 
 

@@ -12,7 +12,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from ..io.atomic import atomic_output
+from ..io.guard import output_file
+from ..render.output import save_png
 from ..render.style import OUTSIDE_RIGHT, with_picture_text
 from .plan import Axis, SweepError, _is_number, _label, _numeric_axis, key_spec, toml_value
 
@@ -88,15 +89,20 @@ def plot_figure(rows: list[dict], axes: list[Axis], figure: str, folder: Path, t
     """Write ``<figure>_vs_<key>.png`` into ``folder`` and return its path; raises :class:`SweepError`."""
     swept = [a for a in axes if a.swept]
     x_axis = next(a for a in swept if _numeric_axis(a))
-    numeric = sorted({k for r in rows for k, v in r.items() if _is_number(v) and k not in {a.key for a in swept}})
+    check_figure(rows, axes, figure, folder)
+    fig = sweep_figure(rows, axes, figure, title)
+    path = folder / re.sub(r"[^A-Za-z0-9._=+-]", "-", f"{figure}_vs_{x_axis.key}.png")
+    save_png(fig, output_file(path, option="--plot"), 120)
+    return path
+
+
+def check_figure(rows: list[dict], axes: list[Axis], figure: str, folder: Path) -> None:
+    """Refuse (:class:`SweepError`) a ``figure`` that is not a numeric summary column of ``rows``."""
+    swept = {a.key for a in axes if a.swept}
+    numeric = sorted({k for r in rows for k, v in r.items() if _is_number(v) and k not in swept})
     if figure not in numeric:
         raise SweepError(f"--plot {figure}: not a numeric column of {folder / 'results.csv'}; "
                          f"allowed: {', '.join(numeric) or '(no run completed)'}")
-    fig = sweep_figure(rows, axes, figure, title)
-    path = folder / re.sub(r"[^A-Za-z0-9._=+-]", "-", f"{figure}_vs_{x_axis.key}.png")
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
-    return path
 
 
 def _shown(value) -> str:

@@ -2,11 +2,30 @@
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from pathlib import Path
 
 from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+
+PLANNING_SHOWN = 500   # combinations from which resolving them shows a bar (10^4 take about ten seconds)
+
+
+@contextmanager
+def planning(total: int, quiet: bool = False):
+    """While a sweep resolves its combinations: a transient bar on a terminal for large sweeps; yields the
+    ``on_point(i, n)`` callback for :func:`ropesim.sweep.plan.plan`."""
+    console = Console(stderr=True, highlight=False)
+    if quiet or total < PLANNING_SHOWN or not console.is_terminal:
+        yield None
+        return
+    progress = Progress(TextColumn("[bold]planning"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                        console=console, transient=True)
+    task = progress.add_task("planning", total=total)
+    with progress:
+        yield lambda i, n: progress.update(task, completed=i) if i % 100 == 0 or i == n else None
 
 
 class SweepProgress:

@@ -16,11 +16,11 @@ from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 
+from ..io.guard import HTML_MARK as GENERATOR   # the write guard knows ropesim's pages by it
 from . import ViewError
 from .content import RunContent, run_content
 from .pack import PAGE_BUDGET, description_json, pack, select_frames
 
-GENERATOR = '<meta name="generator" content="ropesim view">'
 HEAD_BYTES = 1024           # the generator tag is within this many bytes of a page's start
 NOTEBOOK_BUDGET = 20_000_000   # [bytes] a notebook keeps its outputs: its pages are thinned sooner
 COLORMAP = "viridis"
@@ -133,13 +133,11 @@ def _fill(parts: dict[str, str], description: str, data: str) -> str:
 
 
 def written_by_ropesim(path: Path) -> bool:
-    """True if ``path`` is a page ropesim wrote (its generator tag near the start)."""
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(HEAD_BYTES)
-    except OSError:
-        return False
-    return GENERATOR.encode() in head
+    """True if ``path`` is a page ropesim wrote (its generator tag near the start; the write guard's check,
+    :func:`ropesim.io.guard.written_by_ropesim`)."""
+    from ..io.guard import written_by_ropesim as ours
+
+    return ours(path)
 
 
 def check_target(path: Path, option: str | None = "--out") -> None:
@@ -150,9 +148,13 @@ def check_target(path: Path, option: str | None = "--out") -> None:
         raise ViewError(f"{where}: a page is an .html file; give a name ending in .html")
     if path.is_dir():
         raise ViewError(f"{where}: is a folder; give a file name ending in .html")
-    if path.exists() and not written_by_ropesim(path):
+    from ..io.guard import WriteRefused, output_file
+
+    try:
+        output_file(path, option=option or "")   # the one write guard: a link followed, a folder refused
+    except WriteRefused:
         raise ViewError(f"{where}: exists and was not written by ropesim; it is left alone: remove it or "
-                        f"choose another file{' with --out' if not option else ''}")
+                        f"choose another file{' with --out' if not option else ''}") from None
 
 
 def save_html(text: str, path: Path, option: str | None = "--out") -> Path:
