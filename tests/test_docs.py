@@ -7,7 +7,10 @@
 - The scene reference's TOML examples load.
 - The tutorials' command blocks are real: each block marked ``<!-- run -->`` runs, in page order, in a scratch
   folder (fast suite: scene end times capped; slow suite: everything exactly as written, ``<!-- run: slow -->``
-  blocks included).
+  blocks included), and the page shows every picture they draw.
+- The built site as a reader sees it at 1280 px (headless Chromium): no code block wider than the column, no
+  picture shown far smaller than its file without a click to zoom, every equation typeset, no request leaving
+  the site.
 """
 
 from __future__ import annotations
@@ -18,10 +21,8 @@ import importlib
 import importlib.util
 import os
 import re
-import shutil
 import subprocess
 import sys
-import textwrap
 import tomllib
 from dataclasses import fields
 from pathlib import Path
@@ -41,14 +42,19 @@ API_PAGE = DOCS / "reference" / "api.md"
 TUTORIAL_PAGES = [DOCS / "getting-started.md", *sorted((DOCS / "tutorials").glob("*.md"))]
 
 
-def _hook():
-    spec = importlib.util.spec_from_file_location("ropesim_docs_reference", DOCS / "hooks" / "reference.py")
+def _load(path: Path, name: str):
+    spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
 
 
+def _hook():
+    return _load(DOCS / "hooks" / "reference.py", "ropesim_docs_reference")
+
+
 REF = _hook()
+BLOCKS = _load(ROOT / "scripts" / "tutorial_blocks.py", "ropesim_tutorial_blocks")
 
 
 # ------------------------------------------------------------------------ the schema, walked independently
@@ -330,9 +336,186 @@ def test_built_site_has_every_page_and_image(site):
         assert (site / image.relative_to(DOCS)).is_file()
 
 
-# -------------------------------------------------------------------------------------- tutorials' commands
+def test_the_notebooks_are_pages_with_their_outputs(site):
+    """mkdocs-jupyter executed docs/notebooks/*.ipynb at the build: their pages show what the cells printed and
+    drew (the stored notebooks have no outputs; tests/test_notebook.py runs them too)."""
+    quickstart = (site / "notebooks" / "quickstart" / "index.html").read_text(encoding="utf-8")
+    assert "ropesim.Trajectory" in quickstart and "&lt;video" not in quickstart and "<video" in quickstart
+    plots = r'<img[^>]* src="data:image/png;base64,'                 # matplotlib's figures
+    assert len(re.findall(plots, quickstart)) == 1 and "the rope trails" in quickstart
+    moorings = (site / "notebooks" / "moorings" / "index.html").read_text(encoding="utf-8")
+    assert len(re.findall(plots, moorings)) == 3
+    assert "fairlead load 360 to 1782 kN after the ramp" in moorings
+    for page in (quickstart, moorings):                           # no error, nothing on stderr (a warning)
+        assert not re.search(r'<div[^>]* data-mime-type="application/vnd.jupyter.stderr"', page)
+        assert "Traceback" not in page
 
-BLOCK = re.compile(r"^<!-- run(: slow)? -->\n+```(\w+)([^\n]*)\n(.*?)^```", re.M | re.S)
+
+# ------------------------------------------------------------------ the built site in a browser, at 1280 px
+
+VIEWPORT = (1280, 900)      # a laptop's screen: both sidebars shown, a 748-px column on most pages
+READABLE_PX = 200           # a picture shown smaller than its file is still at least this wide (or its own width)
+REPOSITORY_FACTS = "https://api.github.com/repos/pyropesim/ropesim"   # Material's star count: optional, may fail
+PROBE = "_probe"            # a page made wrong on purpose, to show that each check below catches what it checks
+PROBE_CONTENT = (
+    "<pre><code>" + "x" * 200 + "</code></pre>"
+    '<img src="../images/accuracy_helicopter.png" style="width: 300px">'          # 1210 px wide, no zoom
+    '<a class="glightbox" href="../images/accuracy_helicopter.png">'
+    '<img src="../images/accuracy_helicopter.png" style="width: 150px"></a>'      # zoom, but too small
+    '<span class="arithmatex">\\(\\frac{1}{\\)</span>'                           # a TeX mistake
+    '<link rel="preload" href="https://example.org/font.woff2" as="font" crossorigin>')
+
+# What each page shows, measured in the page: every code block's overflow (the block scrolls sideways by this
+# many pixels), every picture's shown and natural width and whether a click opens it full size, every equation.
+MEASURE = """async () => {
+  for (const d of document.querySelectorAll('article details')) d.open = true;
+  for (const img of document.querySelectorAll('article img')) img.loading = 'eager';
+  await Promise.all([...document.querySelectorAll('article img')].map(i => i.decode().catch(() => null)));
+  await document.fonts.ready;
+  const code = [...document.querySelectorAll('article pre')].map(pre => {
+    const boxes = [pre, ...pre.querySelectorAll(':scope > code')];
+    return {overflow: Math.max(...boxes.map(b => b.scrollWidth - b.clientWidth)),
+            line: pre.textContent.split('\\n').reduce((a, b) => b.length > a.length ? b : a, '').slice(0, 70)};
+  });
+  const pictures = [...document.querySelectorAll('article img')].map(img => {
+    const link = img.closest('a');
+    const src = img.currentSrc || img.src;
+    return {src: src.startsWith('data:') ? src.slice(0, 40) : src, shown: img.getBoundingClientRect().width,
+            natural: img.naturalWidth,
+            zoom: !!link && (link.classList.contains('glightbox') || link.href === src)};
+  });
+  const equations = [...document.querySelectorAll('article .arithmatex')].map(e => ({
+    tex: e.querySelector('annotation') ? e.querySelector('annotation').textContent : e.textContent,
+    typeset: !!e.querySelector('.katex') && !e.querySelector('.katex-error')}));
+  return {code, pictures, equations, column: document.querySelector('article').clientWidth};
+}"""
+
+
+def _serve_only(base: str, left: list[str], route) -> None:
+    """Let a page load what the site serves; record every request that would leave it, and refuse it (Material's
+    request for the repository's star count gets a made-up answer, as if the host had been reached)."""
+    url = route.request.url
+    if url.startswith((base, "data:", "blob:")):
+        route.continue_()
+        return
+    left.append(url)
+    if url.startswith(REPOSITORY_FACTS):
+        route.fulfill(status=200, content_type="application/json",
+                      body='{"stargazers_count": 0, "forks_count": 0, "tag_name": "v0.1.0"}')
+    else:
+        route.abort()
+
+
+@pytest.fixture(scope="module")
+def rendered(site) -> dict[str, dict]:
+    """Every page of the built site as Chromium shows it at 1280 px, served from 127.0.0.1 (as a web host would):
+    {page: what MEASURE returns, plus the requests that left the site and the console's errors}. Skipped
+    without a browser, unless ROPESIM_REQUIRE_BROWSER=1 (CI)."""
+    import functools
+    import http.server
+    import threading
+
+    from ropesim.viewer import headless
+
+    why = headless.missing()
+    if why:
+        if os.environ.get("ROPESIM_REQUIRE_BROWSER") == "1":
+            pytest.fail(f"ROPESIM_REQUIRE_BROWSER=1 but {why}", pytrace=False)
+        pytest.skip(why)
+
+    class Quiet(http.server.SimpleHTTPRequestHandler):
+        def log_message(self, *args):
+            pass
+
+    page = (site / "getting-started" / "index.html").read_text(encoding="utf-8")
+    article = re.search(r'<article class="md-content__inner md-typeset">', page).end()
+    (site / PROBE).mkdir(exist_ok=True)
+    (site / PROBE / "index.html").write_text(page[:article] + PROBE_CONTENT + page[article:], encoding="utf-8")
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(Quiet, directory=str(site)))
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    base = f"http://127.0.0.1:{server.server_address[1]}/"
+    folders = [p.parent.relative_to(site) for p in site.rglob("index.html")]
+    pages = sorted("" if f == Path(".") else f.as_posix() for f in folders)
+    out = {}
+    try:
+        with headless.browser() as browser:
+            for name in pages:
+                tab = browser.context.new_page()
+                tab.set_viewport_size({"width": VIEWPORT[0], "height": VIEWPORT[1]})
+                left, errors = [], []
+                tab.route("**/*", functools.partial(_serve_only, base, left))
+                tab.on("console", lambda m, errors=errors: errors.append(m.text) if m.type == "error" else None)
+                tab.on("pageerror", lambda e, errors=errors: errors.append(str(e)))
+                tab.goto(base + name + ("/" if name else ""), wait_until="load")
+                out[name or "home"] = {**tab.evaluate(MEASURE), "left": left, "errors": errors}
+                tab.close()
+    finally:
+        server.shutdown()
+    return out
+
+
+def wide_blocks(shown: dict) -> list[str]:
+    return [f"{block['overflow']} px too wide: {block['line']!r}" for block in shown["code"] if block["overflow"] > 1]
+
+
+def small_pictures(shown: dict) -> list[str]:
+    problems = []
+    for picture in shown["pictures"]:
+        if picture["natural"] == 0:
+            problems.append(f"{picture['src']} did not load")
+        elif picture["shown"] < 0.5 * picture["natural"] and not picture["zoom"]:
+            problems.append(f"{picture['src']} shown {picture['shown']:.0f} px of its {picture['natural']}, and "
+                            f"no click opens it full size")
+        elif picture["shown"] < min(READABLE_PX, picture["natural"]) - 1:
+            problems.append(f"{picture['src']} shown only {picture['shown']:.0f} px wide")
+    return problems
+
+
+def untypeset(shown: dict) -> list[str]:
+    return [eq["tex"] for eq in shown["equations"] if not eq["typeset"]]
+
+
+def left_the_site(shown: dict) -> list[str]:
+    return [url for url in shown["left"] if not url.startswith(REPOSITORY_FACTS)]
+
+
+def _each_page(rendered: dict, check) -> dict[str, list[str]]:
+    found = {page: check(shown) for page, shown in rendered.items() if page != PROBE}
+    return {page: problems for page, problems in found.items() if problems}
+
+
+def test_code_blocks_fit_the_column_at_1280_px(rendered):
+    """No code block scrolls sideways on a 1280-px screen: commands and outputs are reflowed to the column."""
+    assert _each_page(rendered, wide_blocks) == {}
+    assert sum(len(shown["code"]) for shown in rendered.values()) > 100      # the blocks were found
+    assert len(wide_blocks(rendered[PROBE])) == 1                            # and a wide one is caught
+
+
+def test_pictures_are_shown_readably_with_click_to_zoom(rendered):
+    """A picture is shown at least half its file's width, or a click opens it full size; never narrower than
+    READABLE_PX (or its own width); and every picture loaded."""
+    assert _each_page(rendered, small_pictures) == {}
+    assert sum(p["zoom"] for shown in rendered.values() for p in shown["pictures"]) > 50
+    caught = small_pictures(rendered[PROBE])                                 # the probe's two shrunken pictures
+    assert len(caught) == 2 and "no click" in caught[0] and "only" in caught[1], caught
+
+
+def test_equations_are_typeset_by_the_sites_own_katex(rendered):
+    assert _each_page(rendered, untypeset) == {}
+    for page in ("background/physics", "background/accuracy", "background/validation"):
+        assert rendered[page]["equations"], f"{page}: no equations"
+    assert untypeset(rendered[PROBE]) == [r"\frac{1}{"]
+
+
+def test_pages_need_no_network_and_log_no_error(rendered):
+    """Fonts, KaTeX, the lightbox and the notebooks' outputs all come from the site; Material's star count of
+    the repository is the one request that may leave it (the page works without it)."""
+    assert _each_page(rendered, left_the_site) == {}
+    assert left_the_site(rendered[PROBE]) == ["https://example.org/font.woff2"]
+    assert _each_page(rendered, lambda shown: shown["errors"]) == {}
+
+
+# -------------------------------------------------------------------------------------- tutorials' commands
 
 # The fast suite runs the tutorials' commands through this stand-in for `ropesim`, which caps every scene's
 # end time (and asks `frames` for two frames instead of times the capped run does not reach). The slow suite
@@ -366,16 +549,9 @@ if __name__ == "__main__":  # sweeps start worker processes, which import this f
 """
 
 
-def runnable_blocks(page: Path) -> list[tuple[bool, str, str, str]]:
-    """(slow, language, fence info, code) of every block marked <!-- run --> or <!-- run: slow -->."""
-    return [(bool(m.group(1)), m.group(2), m.group(3), m.group(4))
-            for m in BLOCK.finditer(page.read_text(encoding="utf-8"))]
-
-
 def _workspace(tmp_path: Path, capped: bool) -> dict:
     """A scratch folder with scenarios/ and scripts/, and the environment to run a page's blocks in."""
-    for name in ("scenarios", "scripts"):
-        shutil.copytree(ROOT / name, tmp_path / name)
+    BLOCKS.workspace(tmp_path)
     bin_dir = Path(sys.executable).parent
     path = [str(bin_dir)]
     if capped:
@@ -390,37 +566,23 @@ def _workspace(tmp_path: Path, capped: bool) -> dict:
     return env
 
 
-def run_page(page: Path, tmp_path: Path, slow: bool) -> None:
-    blocks = runnable_blocks(page)
+def run_page(page: Path, tmp_path: Path, slow: bool) -> set[str]:
+    """Run the page's blocks in order (slow ones too with ``slow``); the pictures they drew."""
     env = _workspace(tmp_path, capped=not slow)
-    for is_slow, language, info, code in blocks:
+    for is_slow, language, info, code in BLOCKS.runnable_blocks(page):
         if is_slow and not slow:
             continue
-        title = re.search(r'title="([^"]+)"', info)
-        if title:
-            (tmp_path / title.group(1)).write_text(code, encoding="utf-8")
-            continue
-        if language == "bash":
-            command = ["bash", "-euo", "pipefail", "-c", code]
-        elif language == "python":
-            command = [sys.executable, "-c", code]
-        else:
-            pytest.fail(f"{page.name}: a runnable ```{language} block must be bash, python or have a title=")
-        proc = subprocess.Popen(command, cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                text=True, start_new_session=True)
         try:
-            output, _ = proc.communicate(timeout=900)
-        finally:
-            if proc.poll() is None:
-                os.killpg(proc.pid, 9)
-        assert proc.returncode == 0, (f"{page.relative_to(ROOT)}: this block failed (exit {proc.returncode}):\n"
-                                      f"{textwrap.indent(code, '    ')}\n{output[-4000:]}")
+            BLOCKS.run_block(page, language, info, code, tmp_path, env)
+        except AssertionError as exc:
+            pytest.fail(str(exc).replace(page.name, str(page.relative_to(ROOT)), 1))
+    return BLOCKS.pictures_in(tmp_path)
 
 
 @pytest.mark.parametrize("page", TUTORIAL_PAGES, ids=lambda p: p.stem)
 def test_tutorial_pages_have_runnable_commands(page):
     """Every tutorial (and getting started) marks its commands to run; an unmarked page would go untested."""
-    blocks = runnable_blocks(page)
+    blocks = BLOCKS.runnable_blocks(page)
     if page.name == "index.md":
         return
     assert blocks, f"{page}: no <!-- run --> block"
@@ -433,16 +595,35 @@ def test_tutorial_pages_have_runnable_commands(page):
 QUICK_PAGES = ("getting-started.md",)
 
 
+def assert_pictures_shown(page: Path, drawn: set[str]) -> None:
+    """Every picture the page's commands drew is on the page, naming the drawn file in its title
+    (scripts/make_tutorial_images.py keeps them), and every such picture's file exists."""
+    shown = BLOCKS.shown_pictures(page)
+    assert drawn <= set(shown), f"{page.name} does not show what its commands drew: {sorted(drawn - set(shown))}"
+    for title, src in shown.items():
+        assert (page.parent / src).is_file(), f"{page.name}: {src} (of {title}) is missing"
+
+
 @pytest.mark.parametrize("page", [p for p in TUTORIAL_PAGES if p.name in QUICK_PAGES], ids=lambda p: p.stem)
-def test_tutorial_commands_run(page, tmp_path):
-    """The page's <!-- run --> blocks, in order, with every scene's end time capped."""
-    run_page(page, tmp_path, slow=False)
+def test_tutorial_commands_run_and_their_pictures_are_shown(page, tmp_path):
+    """The page's <!-- run --> blocks, in order, with every scene's end time capped; the page shows what they
+    drew."""
+    assert_pictures_shown(page, run_page(page, tmp_path, slow=False))
+
+
+def test_a_picture_the_commands_drew_and_the_page_does_not_show_is_caught(tmp_path):
+    page = tmp_path / "page.md"
+    page.write_text('![a](pic.png "runs/a/frames.png")\n', encoding="utf-8")
+    (tmp_path / "pic.png").write_bytes(b"")
+    assert_pictures_shown(page, {"runs/a/frames.png"})
+    with pytest.raises(AssertionError, match="runs/b/plots.png"):
+        assert_pictures_shown(page, {"runs/a/frames.png", "runs/b/plots.png"})
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("page", [p for p in TUTORIAL_PAGES if p.name != "index.md"], ids=lambda p: p.stem)
 def test_tutorial_commands_run_as_written(page, tmp_path):
-    """Every marked block, slow ones too, exactly as written."""
+    """Every marked block, slow ones too, exactly as written; the page shows every picture they drew."""
     if page.name == "sweeps.md" and importlib.util.find_spec("distributed") is None:
         pytest.skip('the Dask tutorial needs the dask extra (pip install -e ".[dask]")')
-    run_page(page, tmp_path, slow=True)
+    assert_pictures_shown(page, run_page(page, tmp_path, slow=True))

@@ -31,3 +31,13 @@ def test_the_typo_message_in_the_tutorial_is_the_one_ropesim_prints(tmp_path):
         load_scene(tmp_path / "falling_chain.toml", ["rope.nodse=31"])
     message = str(caught.value).replace(str(tmp_path / "falling_chain.toml"), "falling_chain.toml")
     assert shown == f"ropesim: {message}"
+
+
+def test_the_typo_message_on_getting_started_is_the_one_ropesim_prints(monkeypatch):
+    page = (DOCS / "getting-started.md").read_text(encoding="utf-8")
+    command = re.search(r"\$ ropesim run (\S+) --set (\S+)\n(ropesim: .*)\n", page)
+    scene, override, shown = command.groups()
+    monkeypatch.chdir(DOCS.parent)                 # the page's commands run at the root of a clone
+    with pytest.raises(SceneError) as caught:
+        load_scene(scene, [override])
+    assert shown == f"ropesim: {caught.value}"

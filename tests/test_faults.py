@@ -8,6 +8,7 @@ run. The fast suite runs a handful of representative cases; ``-m slow`` runs sev
 from __future__ import annotations
 
 import errno
+import fcntl
 import json
 import os
 import random
@@ -15,6 +16,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 import zipfile
 from pathlib import Path
@@ -77,6 +79,21 @@ def assert_identical(folder: Path, clean: Path) -> None:
     assert not (folder / "checkpoint").exists() and not (folder / ".lock").exists()
 
 
+FINISHED_FILES = {"trajectory.npz", "ledger.npz", "summary.json", "state.npz", "manifest.json", "scene.toml"}
+
+
+def assert_killed_after_the_commit(folder: Path, clean: Path) -> None:
+    """A kill -9 in the milliseconds between a run's completing commit and its lock's removal: the run is whole,
+    what is left beside it (.lock, perhaps the streams) is nobody's, and the next writer of the folder removes
+    it. (Nothing runs after a SIGKILL, so no writer can promise to have cleaned up by then.)"""
+    assert set(os.listdir(folder)) - FINISHED_FILES <= {".lock", "checkpoint"}
+    assert runfolder.holder(folder) is None               # a stale lock is not taken for a live writer
+    assert Trajectory.open(folder).summary["status"] == "completed"
+    with pytest.raises(RunFolderError, match="already completed"):
+        resume(folder)                                    # not blocked by it, and it cleans up
+    assert_identical(folder, clean)
+
+
 def assert_prefix(folder: Path, clean: Path) -> int:
     """The unfinished run's frames are the clean run's first frames, exactly; returns how many."""
     traj = Trajectory.open(folder)
@@ -112,6 +129,9 @@ def fault_case(tmp_path: Path, clean_root: Path, method: str, sig: int, delay: f
         proc.send_signal(sig)
     _, err = proc.communicate(timeout=120)
     manifest = json.loads((folder / "manifest.json").read_text())
+    if manifest["status"] == "completed" and proc.returncode == -signal.SIGKILL:
+        assert_killed_after_the_commit(folder, clean)
+        return
     if manifest["status"] == "completed":       # it finished before the signal came
         assert_identical(folder, clean)
         return
@@ -170,6 +190,52 @@ def test_random_signals_on_real_runs(tmp_path, clean_root, seed):
     method = rng.choice(sorted(T_END))
     sig = rng.choice([signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGKILL, signal.SIGKILL])
     fault_case(tmp_path, clean_root, method, sig, rng.uniform(0.0, 1.2))
+
+
+# A real run killed (SIGKILL) at one point after its completing commit: the manifest's rename ("commit"), the
+# streams' removal ("streams"), or the start of the folder's last fsync ("flush").
+KILLED_AFTER_THE_COMMIT = """
+import os, signal, sys, ropesim
+from ropesim.io import runfolder
+point, committed = sys.argv[3], []
+write_json_durable, remove_tree, fsync_path = runfolder.write_json_durable, runfolder._remove_tree, runfolder.fsync_path
+def kill_at(here):
+    if here == point and committed:
+        os.kill(os.getpid(), signal.SIGKILL)
+def commit(path, data):
+    write_json_durable(path, data)
+    if data["status"] == "completed":
+        committed.append(path)
+    kill_at("commit")
+def remove(path):
+    remove_tree(path)
+    kill_at("streams")
+def flush(path):
+    kill_at("flush")
+    fsync_path(path)
+runfolder.write_json_durable, runfolder._remove_tree, runfolder.fsync_path = commit, remove, flush
+ropesim.simulate(ropesim.load_scene(sys.argv[1], sys.argv[4:]), sys.argv[2])
+"""
+
+
+@pytest.mark.parametrize("point", ["commit", "streams", "flush"])
+def test_kill_9_after_the_final_commit(tmp_path, point):
+    """CI's seed 11 of the random signals: a SIGKILL landed after the run's completing commit and after its
+    streams went, while the folder was flushed, and left .lock beside the completed run. The lock now goes with
+    the streams, before that flush; a kill before it leaves a lock nobody holds, which blocks nothing and which
+    the next writer removes with any streams left."""
+    sets = _sets("verlet", 20.0)
+    clean = tmp_path / "clean"
+    simulate(ropesim.load_scene(SCENE, sets), clean)
+    folder = tmp_path / "run"
+    proc = subprocess.run([sys.executable, "-c", KILLED_AFTER_THE_COMMIT, str(SCENE), str(folder), point, *sets],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == -signal.SIGKILL, proc.stderr
+    assert json.loads((folder / "manifest.json").read_text())["status"] == "completed"
+    if point == "flush":
+        assert_identical(folder, clean)                   # nothing left behind: no .lock, no streams
+    else:
+        assert_killed_after_the_commit(folder, clean)
 
 
 # ------------------------------------------------------------------------------------ full disk
@@ -276,6 +342,34 @@ def test_a_second_writer_is_refused_naming_the_first(tmp_path):
         proc.wait()
     simulate(ropesim.load_scene(SCENE, ["integrator.t_end=1"]), folder)   # the dead holder's lock is gone
     assert Trajectory.open(folder).summary["status"] == "completed"
+
+
+def test_a_reader_asking_who_writes_never_refuses_the_next_writer(tmp_path):
+    """holder() (a reader: `ropesim view` of an unfinished run, a replacement clearing leftovers) takes the lock
+    shared for an instant. A writer starting in that instant was refused, "another ropesim is writing", naming
+    whoever the stale .lock last recorded: here a run killed long ago."""
+    folder = tmp_path / "run"
+    simulate(ropesim.load_scene(SCENE, ["integrator.t_end=0.1"]), folder)
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    (folder / ".lock").write_text(json.dumps({"pid": dead.pid, "command": "ropesim run (killed)", "since": "then"}))
+    assert runfolder.holder(folder) is None               # stale: nobody holds it
+    probe = os.open(folder / ".lock", os.O_RDONLY)
+    fcntl.flock(probe, fcntl.LOCK_SH)                     # the reader's instant, caught
+    threading.Timer(0.05, os.close, [probe]).start()
+    simulate(ropesim.load_scene(SCENE, ["integrator.t_end=0.2"]), folder)   # waits the reader out
+    assert Trajectory.open(folder).t[-1] == 0.2 and not (folder / ".lock").exists()
+
+    writer = os.open(folder / ".lock", os.O_RDWR | os.O_CREAT)   # a writer holds it: refused at once, named
+    fcntl.flock(writer, fcntl.LOCK_EX)
+    os.write(writer, json.dumps({"pid": os.getpid(), "command": "ropesim run x", "since": "now"}).encode())
+    try:
+        started = time.monotonic()
+        with pytest.raises(RunFolderBusy, match=f"pid {os.getpid()}, `ropesim run x`"):
+            resume(folder)
+        assert time.monotonic() - started < runfolder.READERS_WAIT
+    finally:
+        os.close(writer)
 
 
 def test_a_rerun_replaces_the_whole_folder(tmp_path):

@@ -1,9 +1,11 @@
 """Notebook users: a Trajectory's HTML summary, an animation that plays inline, and docs/notebooks/*.ipynb
-executed from the first cell to the last (nbclient), so the quickstart cannot rot."""
+executed from the first cell to the last (nbclient), so the quickstart and the moorings notebook cannot rot
+(the site executes them again at every build: mkdocs-jupyter)."""
 
 from __future__ import annotations
 
 import base64
+import re
 from pathlib import Path
 
 import imageio_ffmpeg
@@ -66,8 +68,18 @@ def test_the_notebooks_run_without_an_error_or_a_warning(path, tmp_path):
         assert any(h.startswith("<video") for h in html)
         viewers = [h for h in html if '<iframe sandbox="allow-scripts" srcdoc=' in h]   # the browser viewer
         assert len(viewers) == 2 and all("ropesim-data" in h for h in viewers)
-        assert (tmp_path / "helicopter_mass.html").is_file()
+        assert (tmp_path / "runs" / "helicopter_mass.html").is_file()
+    if path.name == "moorings.ipynb":
+        assert any("ropesim.Trajectory" in h and "mooring_chain" in h for h in html)
+        pictures = [o for o in outputs if "image/png" in o.get("data", {})]
+        assert len(pictures) == 3                       # tensions over time, along the chain, peak against surge
+        text = "".join(o.text for o in outputs if o.output_type == "stream")
+        assert "fairlead load 360 to 1782 kN after the ramp" in text   # as the moorings tutorial says
+        peaks = [float(p) for p in re.findall(r"largest fairlead load (\d+) kN", text)]
+        assert len(peaks) == 5 and all(b > a for a, b in zip(peaks, peaks[1:]))   # grows with the surge
+        assert all((tmp_path / "runs" / name).is_file() for name in ("mooring.csv", "mooring_tension_history.csv",
+                                                             "mooring_tension_range.csv"))
 
 
-def test_there_is_a_notebook():
-    assert [p.name for p in NOTEBOOKS] == ["quickstart.ipynb"]
+def test_there_are_the_notebooks():
+    assert [p.name for p in NOTEBOOKS] == ["moorings.ipynb", "quickstart.ipynb"]

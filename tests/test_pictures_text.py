@@ -20,6 +20,7 @@ from ropesim.model.build import build
 from ropesim.render.animate import FrameRenderer, animate
 from ropesim.render.frames import frame_sheet
 from ropesim.render.framing import projection
+from ropesim.render import style
 from ropesim.render.plots import plot_run, run_figure
 from ropesim.sweep.plan import Axis
 from ropesim.sweep.plot import figure_label, key_label, sweep_figure
@@ -170,17 +171,50 @@ def _no_warnings(make, caplog, capfd):
     assert err == "", err
 
 
-def test_a_cjk_scene_name_draws_without_a_warning(tmp_path, caplog, capfd):
+def _cjk_run(tmp_path):
     text = (SCENARIOS / "helicopter_parachute.toml").read_text().replace(
         'name = "helicopter_parachute"', 'name = "直升机绳子"')
     (tmp_path / "s.toml").write_text(text)
     scene = ropesim.load_scene(tmp_path / "s.toml", ["integrator.t_end=0.05"])
     assert scene.name == "直升机绳子"
-    traj = ropesim.simulate(scene, tmp_path / "run")
+    return ropesim.simulate(scene, tmp_path / "run")
+
+
+def test_a_cjk_scene_name_draws_without_a_warning_where_a_font_has_it(tmp_path, caplog, capfd, monkeypatch):
+    """With a font that covers the name (as on a machine with fonts-noto-cjk), titles keep it as written."""
+    covered = style._drawn_by_installed_fonts() | frozenset(map(ord, "直升机绳子"))
+    monkeypatch.setattr(style, "_drawn_by_installed_fonts", lambda: covered)
+    monkeypatch.setattr(style, "_noted", set())
+    traj = _cjk_run(tmp_path)
     _no_warnings(lambda: plot_run(traj, tmp_path / "p.png"), caplog, capfd)
     _no_warnings(lambda: frame_sheet(traj, tmp_path / "f.png"), caplog, capfd)
     _no_warnings(lambda: animate(traj, tmp_path / "a.gif", size=160), caplog, capfd)
     assert all((tmp_path / f).stat().st_size > 1000 for f in ("p.png", "f.png", "a.gif"))
+    fig, _ = run_figure(traj)
+    assert fig.get_suptitle().startswith("直升机绳子")
+
+
+def test_a_cjk_scene_name_no_font_draws_shows_code_points_and_one_note(tmp_path, caplog, capfd, monkeypatch):
+    """Without such a font, titles show the characters' code points (never empty boxes) and one note line names
+    the font package to install, once for all the pictures; no warning."""
+    covered = frozenset(c for c in style._drawn_by_installed_fonts() if not 0x2E80 <= c <= 0x9FFF)   # no CJK
+    monkeypatch.setattr(style, "_drawn_by_installed_fonts", lambda: covered)
+    monkeypatch.setattr(style, "_noted", set())
+    traj = _cjk_run(tmp_path)
+    capfd.readouterr()
+    with caplog.at_level(logging.WARNING), warnings.catch_warnings():
+        warnings.simplefilter("error")
+        plot_run(traj, tmp_path / "p.png")
+        frame_sheet(traj, tmp_path / "f.png")
+        animate(traj, tmp_path / "a.gif", size=160)
+    out, err = capfd.readouterr()
+    assert not caplog.records and out == ""
+    assert err.count("\n") == 1 and err.startswith("note: no installed font draws 直升机绳子") and "fonts-noto-cjk" in err
+    fig, _ = run_figure(traj)
+    assert fig.get_suptitle().startswith("U+76F4 U+5347 U+673A U+7EF3 U+5B50")
+    assert style.title_text("rope 直升机 2") == "rope U+76F4 U+5347 U+673A 2"
+    assert style.title_text("Übung δ") == "Übung δ"   # DejaVu Sans draws these
+    assert capfd.readouterr().err == ""               # its characters were noted already
 
 
 def test_an_accuracy_plot_with_no_completed_run_has_no_legend_and_no_warning(tmp_path, caplog, capfd):

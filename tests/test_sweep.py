@@ -362,15 +362,35 @@ def _alive(pid: int) -> bool:
         return False
 
 
+def _workers(pid: int) -> list[int]:
+    """The sweep's worker processes (its children but multiprocessing's resource tracker)."""
+    def cmdline(child: int) -> bytes:
+        try:
+            return Path(f"/proc/{child}/cmdline").read_bytes()
+        except OSError:
+            return b""
+
+    return [child for child in _children(pid) if b"spawn_main" in cmdline(child)]
+
+
 @pytest.mark.slow
-def test_sigterm_stops_the_sweep_writes_the_table_and_leaves_no_process(tmp_path):
-    """SIGTERM to the sweep alone (as `timeout` or a batch scheduler sends it): exit 143, the running runs stop
-    at their next chunk keeping their checkpoints, no run starts after it, results.csv is written, and no
-    worker process is left behind."""
+@pytest.mark.parametrize("signals", [["SIGTERM"], ["SIGTERM", "SIGTERM", "SIGHUP", "SIGINT"]],
+                         ids=["once", "again-while-it-stops"])
+def test_sigterm_stops_the_sweep_writes_the_table_and_leaves_no_process(tmp_path, signals):
+    """SIGTERM to the sweep alone (as `timeout` or a batch scheduler sends it): exit 143; every run that started
+    stops at its next chunk keeping its checkpoint and its row says interrupted; every run not started says
+    not_run and has no folder; no run starts after the signal; results.csv is whole; no worker is left behind.
+
+    The signal goes once both workers integrate a run of 10^6 s (their frames stream), a state that lasts: no
+    third run can start before it. More signals while the sweep stops (an impatient user, a scheduler's
+    second notice) change nothing: one used to cut the pool's shutdown short, so the table was written before
+    the stopped runs' summaries (all four rows said not_run) and the sweep never exited."""
     import signal
     import subprocess
     import sys
     import time
+
+    from ropesim.io.runfolder import holder
 
     out = tmp_path / "sweep"
     cmd = [sys.executable, "-m", "ropesim", "sweep", str(UNIFORM), "--out", str(out), "-j", "2",
@@ -378,12 +398,17 @@ def test_sigterm_stops_the_sweep_writes_the_table_and_leaves_no_process(tmp_path
     proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         deadline = time.monotonic() + 180
-        while sum(f.stat().st_size > 4096 for f in out.glob("*/checkpoint/x.npy")) < 2:
+        while len(running := {f.parent.parent.name for f in out.glob("*/checkpoint/x.npy")
+                              if f.stat().st_size > 4096}) < 2:
             assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
             time.sleep(0.2)
-        workers = _children(proc.pid)
+        workers = _workers(proc.pid)
         started = time.monotonic()
         proc.send_signal(signal.SIGTERM)
+        for name in signals[1:]:     # while the workers still stop, so inside the sweep's stop for sure
+            time.sleep(0.01)
+            if any(_alive(pid) for pid in workers):
+                proc.send_signal(getattr(signal, name))
         _, stderr = proc.communicate(timeout=120)
         took = time.monotonic() - started
     finally:
@@ -391,8 +416,16 @@ def test_sigterm_stops_the_sweep_writes_the_table_and_leaves_no_process(tmp_path
             os.killpg(proc.pid, signal.SIGKILL)
     assert proc.returncode == 143, stderr
     assert "sweep interrupted by SIGTERM" in stderr and took < 30
+    assert len(workers) == 2 and not [pid for pid in workers if _alive(pid)], "worker processes left behind"
     rows = read_table(out / "results.csv")
-    assert sorted(r["status"] for r in rows) == ["error", "error", "interrupted", "interrupted"]
-    assert all(r["error"].startswith("not run") for r in rows if r["status"] == "error")
-    time.sleep(0.5)
-    assert workers and not [pid for pid in workers if _alive(pid)], "worker processes left behind"
+    assert [r["run"] for r in rows] == [f"drag.b={b}" for b in (4, 5, 6, 7)]
+    assert sorted(p.name for p in out.iterdir()) == sorted([*running, "results.csv"])   # none started after
+    for row in rows:
+        folder = out / row["run"]
+        if row["run"] in running:
+            assert row["status"] == "interrupted" and row["error"].startswith("interrupted at t = "), row
+            assert json.loads((folder / "summary.json").read_text())["status"] == "interrupted"
+            assert json.loads((folder / "manifest.json").read_text())["status"] == "interrupted"
+            assert (folder / "checkpoint").is_dir() and holder(folder) is None   # kept to resume, not locked
+        else:
+            assert row["status"] == "not_run" and row["error"] == "", row

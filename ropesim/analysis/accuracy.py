@@ -27,7 +27,7 @@ from ..model.build import build
 from ..integrate.health import E0, OK, STATUS_NAMES
 from ..integrate.methods import METHODS, get_method
 from ..scene.schema import Scene
-from ..render.style import with_picture_text
+from ..render.style import title_text, with_picture_text
 from .stability import predicted_dt
 
 REFERENCE_METHOD = "pefrl"
@@ -220,7 +220,7 @@ def work_precision_figure(report: Report):
     else:
         for ax in axes:
             ax.text(0.5, 0.5, "no run completed", ha="center", va="center", transform=ax.transAxes)
-    fig.suptitle(f"{report.scene.name}: work-precision to t = {report.t_end:g} s (dotted: reference floor)")
+    fig.suptitle(title_text(f"{report.scene.name}: work-precision to t = {report.t_end:g} s (dotted: reference floor)"))
     return fig
 
 

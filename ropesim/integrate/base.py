@@ -134,14 +134,23 @@ class Method:
         return stable_step(self, 1.0)
 
 
+def spectral_radius(m) -> float:
+    """The largest |eigenvalue| of a real 2x2 matrix, from its trace and determinant (NaN if not finite)."""
+    (a, b), (c, d) = m
+    half, det = 0.5 * (a + d), a * d - b * c
+    disc = half * half - det
+    if disc >= 0.0:
+        root = math.sqrt(disc)
+        return max(abs(half + root), abs(half - root))
+    return math.sqrt(det) if det >= 0.0 else math.nan   # a complex pair: |lambda|^2 = det (NaN: not finite)
+
+
 def _stable(method: Method, h: float, omega: float, gamma_force: float, gamma_drag: float) -> bool:
     try:
         m = method.amplification(h, omega, gamma_force, gamma_drag)
     except OverflowError:   # a backward kick's e^(gamma |c| h) beyond the float range: the kernel's factor is inf
         return False
-    if not np.all(np.isfinite(m)):
-        return False
-    return bool(np.max(np.abs(np.linalg.eigvals(m))) <= 1.0 + 1e-9)
+    return spectral_radius(m.tolist()) <= 1.0 + 1e-9   # False for inf and NaN entries
 
 
 @lru_cache(maxsize=4096)

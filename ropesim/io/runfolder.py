@@ -129,7 +129,11 @@ def _write_all(fd: int, data) -> None:
 
 class FolderLock:
     """An advisory ``flock`` on ``RUN/.lock``, held for the life of a run; the OS drops it when the process
-    dies, however it dies (kill -9 included), so a stale lock never blocks the next run."""
+    dies, however it dies (kill -9 included), so a stale lock never blocks the next run.
+
+    A writer holds the lock exclusively (``LOCK_EX``); a reader asking who writes (:func:`holder`) takes it
+    shared for an instant. A ``.lock`` file nobody holds is stale (a writer killed before it removed the file):
+    it is taken over like a missing one."""
 
     def __init__(self, fd: int, path: Path):
         self.fd, self.path = fd, path
@@ -139,9 +143,7 @@ class FolderLock:
         path = Path(folder) / LOCK
         for _ in range(5):
             fd = os.open(path, os.O_RDWR | os.O_CREAT, FILE_MODE)
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
+            if not _lock_exclusive(fd):
                 holder = _describe_holder(fd)
                 os.close(fd)
                 raise RunFolderBusy(f"{folder}: another ropesim is writing this run folder ({holder}); wait for "
@@ -181,6 +183,33 @@ class FolderLock:
             finally:
                 os.close(self.fd)
                 self.fd = None
+
+
+READERS_WAIT = 2.0   # seconds a writer waits out readers' momentary shared locks (never another writer)
+
+
+def _lock_exclusive(fd: int) -> bool:
+    """Take ``fd``'s ``flock`` exclusively without waiting for a writer: False when another writer holds it.
+
+    A reader's probe (:func:`holder`) holds the lock shared for an instant; a plain ``LOCK_EX | LOCK_NB`` would
+    take that for a writer and refuse the run, naming whoever the lock file last recorded (a finished or
+    killed run). So a refused exclusive lock is tried shared: that succeeds only when no writer holds it
+    (readers alone), and the exclusive lock is tried again once they are done."""
+    deadline = time.monotonic() + READERS_WAIT
+    while True:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return True
+        except BlockingIOError:
+            pass
+        try:
+            fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except BlockingIOError:
+            return False                  # held exclusively: a writer
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.001)
 
 
 def _describe_holder(fd: int) -> str:
@@ -586,6 +615,8 @@ class RunWriter:
             if manifest is None:
                 raise RunFolderError(f"{shown}: has no manifest.json, so it cannot be resumed; run the scene again")
             _remove_own_temporaries(folder)
+            if manifest["status"] in FINISHED:   # streams left by a writer killed after its final commit
+                _remove_tree(folder / CHECKPOINT)
             return cls(folder, lock, manifest, {})
         except BaseException:
             lock.release(remove=True)
@@ -749,7 +780,11 @@ class RunWriter:
     def finish(self, status: str, state: dict, files: dict[str, dict[str, np.ndarray]], summary: dict,
                message: str = "") -> None:
         """A finished run: write ``files`` (name -> arrays, as npz), the final state and the summary, then commit
-        the manifest with ``status``; the checkpoint streams go."""
+        the manifest with ``status``; the checkpoint streams go, and the lock with them.
+
+        Nothing can run after a ``kill -9``: one that lands between the commit and the lock's removal (a few
+        milliseconds) leaves the finished run whole beside a stale ``.lock`` and perhaps the streams. Readers
+        ignore both, nobody holds that lock, and the next writer of the folder removes them (:meth:`reopen`)."""
         self.swap()
         try:
             for name, arrays in files.items():
@@ -769,6 +804,8 @@ class RunWriter:
         write_json_durable(self.folder / MANIFEST, m)
         self.close_streams()
         _remove_tree(self.folder / CHECKPOINT)
+        self.lock.release(remove=True)     # at once: the folder is whole; the fsync below makes both durable
+        self.lock = None
         fsync_path(self.folder)
 
     def mark(self, status: str, message: str, summary: dict | None = None) -> None:

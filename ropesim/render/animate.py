@@ -23,7 +23,7 @@ from .framing import Projection, figure_inches, followed_nodes, origin, projecti
 from ..io.atomic import atomic_output
 from .output import output_path
 from .scene_artist import Geometry, RopeArtist, body_state, legend_handles, style_axes
-from .style import with_picture_text
+from .style import title_text, with_picture_text
 from .timeline import animation_plan
 from .view3d import wants_3d
 
@@ -151,7 +151,7 @@ def picture_title(fig, model: Model, proj: Projection | None) -> None:
     if model.scene.dimension == 3:
         parts.append(f"view {''.join(proj.names)}" if proj is not None else "view 3d")
     height = fig.bbox.height
-    fig.text(4 / fig.bbox.width, 1 - 3 / height, "  ·  ".join(parts), ha="left", va="top", fontsize=9,
+    fig.text(4 / fig.bbox.width, 1 - 3 / height, title_text("  ·  ".join(parts)), ha="left", va="top", fontsize=9,
              fontweight="bold")
     handles = legend_handles(model)
     if handles:

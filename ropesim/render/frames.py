@@ -19,7 +19,7 @@ from ..io.trajectory import Trajectory
 from .framing import figure_inches, fit_box, followed_nodes, origin, projection, view_aspect, view_box
 from .output import output_path, save_png
 from .scene_artist import Geometry, RopeArtist, body_state, legend_handles, style_axes
-from .style import OUTSIDE_RIGHT, with_picture_text
+from .style import OUTSIDE_RIGHT, title_text, with_picture_text
 from .timeline import chosen_frames
 from .view3d import wants_3d
 
@@ -117,7 +117,7 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
             ax.label_outer()   # x labels stay under the bottom row, where the layout leaves the legend room
             ax.set_ylabel("")
     header = model.scene.name + (f"  ·  view {''.join(proj.names)}" if traj.scene.dimension == 3 else "")
-    fig.suptitle(header, x=0.01, ha="left", fontsize=10, fontweight="bold")
+    fig.suptitle(title_text(header), x=0.01, ha="left", fontsize=10, fontweight="bold")
     handles = legend_handles(model)
     if handles:
         fig.legend(handles=handles, loc="outside lower center", ncol=len(handles), frameon=False, fontsize=7)

@@ -30,7 +30,7 @@ from ..io.trajectory import Trajectory
 from .framing import figure_inches, frame_blocks
 from .output import output_path, save_png
 from .scene_artist import legend_handles, line_color
-from .style import OUTSIDE_RIGHT, with_picture_text
+from .style import OUTSIDE_RIGHT, title_text, with_picture_text
 
 DPI = 100
 WIDTH = 860          # [px] the panels, and their legends beside them
@@ -379,7 +379,7 @@ def run_figure(traj: Trajectory, start: float | None = None, stop: float | None 
         ax.xaxis.label.set_fontsize(8)
         ax.yaxis.label.set_fontsize(8)
     title = traj.scene.name + (f": {traj.scene.description}" if traj.scene.description else "")
-    fig.suptitle(title, x=0.01, ha="left", fontsize=10, fontweight="bold", wrap=True)
+    fig.suptitle(title_text(title), x=0.01, ha="left", fontsize=10, fontweight="bold", wrap=True)
     return fig, tuple(p.name for p in panels)
 
 

@@ -762,7 +762,8 @@ class Scene:
 
 # Top-level keys and tables, in the order a resolved scene file lists them.
 TOP_LEVEL_SCALARS = {
-    "name": Spec("str", "scene name (default: the file's stem); runs go to runs/<name>/", required=False),
+    "name": Spec("str", "scene name (default: the file's stem); runs go to runs/<name>/; a character no installed "
+                 "font draws (CJK without fonts-noto-cjk) shows as its code point in picture titles", required=False),
     "description": Spec("str", "one line saying what the scene shows", required=False),
     "dimension": Spec("int", "2 or 3 spatial dimensions", required=False, choices=(2, 3)),
 }

@@ -16,7 +16,7 @@ Rerun, a sweep resumes: a run folder whose summary says completed and whose scen
 scene is kept; an unfinished run of the same scene (interrupted, killed) continues from its last checkpoint,
 bit for bit; any other (blown up, or made from other parameters) runs again. Ctrl-C or SIGTERM stop a sweep
 cleanly: no new run starts, the running ones stop at their next chunk keeping their frames, results.csv is
-written for what finished, and every worker process has exited.
+written for what finished, and every worker process has exited; more signals meanwhile change nothing.
 """
 
 from __future__ import annotations
@@ -127,6 +127,7 @@ def run_sweep(scene_file: str | Path, sets: list[str], out: str | Path | None = 
     cannot be: a full disk).
     """
     from ..io.guard import WriteRefused, output_folder
+    from ..run import stop_signals
     from .plan import parse_axes
     from .progress import PLANNING_SHOWN, planning
 
@@ -159,35 +160,35 @@ def run_sweep(scene_file: str | Path, sets: list[str], out: str | Path | None = 
     result = SweepResult(rows=[], csv_path=root / RESULTS, swept=swept, skipped=len(done))
     from .progress import SweepProgress
 
-    stopped = None
+    stopped = ""
     workers = min(jobs or os.cpu_count() or 1, len(todo))
-    try:
+    try:      # compiling: a stop ends it at once (raised), and no run starts
         if workers > 1 and scheduler is None:
             warm_up([p for p, _ in todo])
         if plots and todo:
             _check_figures_early(todo[0][0], plots, axes, root)
     except (KeyboardInterrupt, Stopped) as exc:
-        stopped = exc
-    with SweepProgress(len(points), quiet) as progress:
+        stopped = exc.name if isinstance(exc, Stopped) else "SIGINT"
+    # From here a stop signal only sets the flag, however many come: the runs in progress stop at their next
+    # chunk, every worker exits, and the table is written, each row saying what its run did.
+    with stop_signals() as flag, SweepProgress(len(points), quiet) as progress:
+        if stopped:
+            flag.set(stopped)
         progress.skipped(len(done), root)
         try:
-            if stopped is not None:
-                raise stopped
-            if todo:
+            if todo and not flag.is_set():
                 if scheduler is not None:
                     from .dask import run_dask
 
-                    results = run_dask(todo, scheduler)
+                    results = run_dask(todo, scheduler, flag.is_set)
                 else:
-                    results = run_local(todo, workers)
+                    results = run_local(todo, workers, flag.is_set)
                 with closing(results):
                     for outcome in results:
                         outcomes[outcome[0].name] = outcome
                         progress.finished(*outcome)
-        except (KeyboardInterrupt, Stopped) as exc:
-            result.interrupted = True
-            result.stopped_by = exc.name if isinstance(exc, Stopped) else "SIGINT"
         finally:
+            result.interrupted, result.stopped_by = flag.is_set(), flag.signal
             result.rows = [_final_row(p, folders[p.name], outcomes.get(p.name)) for p in points]
             result.ran = sum(r["status"] != NOT_RUN for r in result.rows) - len(done)
             root.mkdir(parents=True, exist_ok=True)
@@ -256,7 +257,7 @@ def _check_figures_early(point: Point, plots: list[str], axes, root: Path) -> No
     combination (in memory, a fraction of a second once its kernel is compiled)."""
     from dataclasses import replace
 
-    from ..run import simulate
+    from ..run import INTERRUPTED, simulate
     from .points import scene_from_toml
 
     try:
@@ -264,6 +265,8 @@ def _check_figures_early(point: Point, plots: list[str], axes, root: Path) -> No
         probe = simulate(replace(scene, integrator=replace(scene.integrator, t_end=scene.integrator.dt)))
     except Exception:
         return    # the run itself will say what is wrong with it
+    if probe.summary["status"] == INTERRUPTED:   # stopped while it compiled: the sweep stops too
+        raise Stopped(probe.summary.get("stopped_by", "SIGINT"))
     row = make_row(point, probe.summary, "")
     from .plot import check_figure
 

@@ -10,14 +10,15 @@ bit for bit as a local sweep. Needs the ``dask`` extra (:func:`ropesim.install.i
 from __future__ import annotations
 
 import tempfile
+import time
 import uuid
 from pathlib import Path
-from typing import Iterator
+from typing import Callable, Iterator
 
 import numpy as np
 
 from .plan import Point, SweepError
-from .points import Outcome, _outcome, run_point_safely
+from .points import POLL_SECONDS, Outcome, _outcome, run_point_safely
 from ..io.atomic import write_json_atomic, write_text_atomic
 from ..io.runfolder import SCENE, SUMMARY, TRAJECTORY, write_npz_atomic
 
@@ -46,8 +47,11 @@ def store(result: dict, folder: Path) -> tuple[dict | None, str]:
     return result["summary"], ""
 
 
-def run_dask(todo: list[tuple[Point, Path]], address: str) -> Iterator[Outcome]:
-    """Submit every point to the scheduler at ``address``; yields each outcome as it comes back."""
+def run_dask(todo: list[tuple[Point, Path]], address: str,
+             stopping: Callable[[], bool] = lambda: False) -> Iterator[Outcome]:
+    """Submit every point to the scheduler at ``address``; yields each outcome as it comes back, until
+    ``stopping()`` (asked every POLL_SECONDS) says the sweep was stopped: then the runs not back yet are
+    cancelled."""
     try:
         from dask.distributed import Client, as_completed
     except ImportError:
@@ -63,9 +67,14 @@ def run_dask(todo: list[tuple[Point, Path]], address: str) -> Iterator[Outcome]:
         folders = {p.name: folder for p, folder in todo}
         token = uuid.uuid4().hex[:8]
         futures = {client.submit(run_remote, p.scene_toml, key=f"ropesim-{p.name}-{token}"): p for p, _ in todo}
+        arrived = as_completed(futures, loop=client.loop)
         try:
-            for future in as_completed(futures, loop=client.loop):
-                point = futures[future]
-                yield _outcome(point, lambda: store(future.result(), folders[point.name]))
+            while not arrived.is_empty() and not stopping():
+                if not arrived.has_ready():
+                    time.sleep(POLL_SECONDS)
+                    continue
+                for future in arrived.next_batch(block=False):
+                    point = futures[future]
+                    yield _outcome(point, lambda: store(future.result(), folders[point.name]))
         finally:
             client.cancel([f for f in futures if not f.done()])

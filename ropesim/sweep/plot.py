@@ -14,7 +14,7 @@ from pathlib import Path
 
 from ..io.guard import output_file
 from ..render.output import save_png
-from ..render.style import OUTSIDE_RIGHT, with_picture_text
+from ..render.style import OUTSIDE_RIGHT, title_text, with_picture_text
 from .plan import Axis, SweepError, _is_number, _label, _numeric_axis, key_spec, toml_value
 
 # Summary figures whose name does not end in their unit.
@@ -76,7 +76,7 @@ def sweep_figure(rows: list[dict], axes: list[Axis], figure: str, title: str = "
     failed = sum(r["status"] != "completed" for r in rows)
     ax.set_xlabel(key_label(x_axis.key))
     ax.set_ylabel(figure_label(figure))
-    ax.set_title(f"{title}: {figure} against {x_axis.key}" + (f" ({failed} runs failed)" if failed else ""),
+    ax.set_title(title_text(f"{title}: {figure} against {x_axis.key}" + (f" ({failed} runs failed)" if failed else "")),
                  fontsize=10)
     ax.grid(True, alpha=0.3)
     if others:

@@ -7,7 +7,7 @@ import json
 import multiprocessing
 import os
 import signal
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from pathlib import Path
 from typing import Callable, Iterator
 
@@ -94,26 +94,44 @@ def _worker_start(stop, parent: int) -> None:
 Outcome = tuple[Point, dict | None, str]  # the point, its summary (None if it raised), the error text
 
 
-def run_local(todo: list[tuple[Point, Path]], jobs: int) -> Iterator[Outcome]:
+POLL_SECONDS = 0.1   # how often a sweep's loop asks whether it was stopped
+
+
+def run_local(todo: list[tuple[Point, Path]], jobs: int,
+              stopping: Callable[[], bool] = lambda: False) -> Iterator[Outcome]:
     """Run points in a pool of ``jobs`` fresh processes; yields each outcome as it finishes.
 
-    Closing the generator early (Ctrl-C, SIGTERM) sets the workers' stop event: no run starts after it, and
-    those in progress stop at their next chunk, keeping their frames for a rerun to resume; then every
-    worker has exited.
+    ``stopping()`` is asked every POLL_SECONDS (the sweep's stop signals set it; they raise nothing here, so
+    no exception ever lands inside the pool's own code). Once it is true, or the generator is closed early, the
+    workers' stop event is set: no run starts after it, and those in progress stop at their next chunk, keeping
+    their frames for a rerun to resume; every worker has exited before the outcomes of the runs that stopped
+    meanwhile are yielded (unless the generator was closed: then their folders say how they ended).
     """
     context = multiprocessing.get_context("spawn")
     stop = context.Event()
     pool = ProcessPoolExecutor(max_workers=jobs, mp_context=context, initializer=_worker_start,
                                initargs=(stop, os.getpid()))
-    futures = {pool.submit(run_point_safely, p.scene_toml, str(folder)): p for p, folder in todo}
-    try:
-        for future in as_completed(futures):
-            outcome = _outcome(futures[future], future.result)
+    futures: dict = {}
+
+    def started(done) -> Iterator[Outcome]:
+        for future in done:
+            outcome = _outcome(futures.pop(future), future.result)
             if outcome[2] != NOT_STARTED:
                 yield outcome
+
+    try:
+        for p, folder in todo:
+            if stopping():
+                break
+            futures[pool.submit(run_point_safely, p.scene_toml, str(folder))] = p
+        pending = set(futures)
+        while pending and not stopping():
+            done, pending = wait(pending, timeout=POLL_SECONDS, return_when=FIRST_COMPLETED)
+            yield from started(done)
     finally:
         stop.set()
         pool.shutdown(wait=True, cancel_futures=True)
+    yield from started([f for f in futures if f.done() and not f.cancelled()])   # stopped at their next chunk
 
 
 def _outcome(point: Point, result: Callable[[], tuple[dict | None, str]]) -> Outcome:
