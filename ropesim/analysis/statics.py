@@ -8,7 +8,10 @@ scene's initial shape, the held nodes where the scene holds them at t = 0, and r
   on it at rest (the flow's push on the linear [drag] included) (so a fairlead's is the line's pull on the vessel, reversed);
 - ``tension``: each segment's axial force [N] (spring and damping, zero in a slack segment);
 - with a ``[seabed]``: the nodes resting on it (sunk below its plane), the length of rope they carry, and the
-  touchdown point, the grounded node next to the suspended part.
+  touchdown point, the grounded node next to the suspended part;
+- a system's figures per point and per line: each fixed and driven point's support force (the sum over its
+  line ends), each free point's static position; each line's tensions at its two ends and its largest, its
+  slack segments, the length of it on the seabed and its touchdown node.
 """
 
 from __future__ import annotations
@@ -18,8 +21,37 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..model.build import Model, build
+from ..model.layout import point_ends
 from ..model.statics import _steady_time, solve_equilibrium
+from ..model.tension import line_segments
 from ..scene import schema as S
+
+
+@dataclass(frozen=True)
+class PointFigures:
+    """A system point at rest: its kind, its position [m] and, for a fixed or driven point, the force [N] it
+    exerts on its lines' ends together (the lines' pull on it, reversed)."""
+
+    id: str
+    kind: str
+    position: np.ndarray        # (D,)
+    force: np.ndarray | None    # (D,), None for a free point
+
+
+@dataclass(frozen=True)
+class LineFigures:
+    """A line at rest: its tension [N] at its start and its end (its first and last segments), its largest and in
+    which of its segments, how many of its segments are slack, the length of it resting on the seabed [m] and
+    its touchdown node (the grounded node next to its suspended part), or None."""
+
+    id: str
+    start_tension: float
+    end_tension: float
+    largest: float
+    largest_segment: int
+    slack: int
+    grounded_length: float
+    touchdown: int | None
 
 
 @dataclass(frozen=True)
@@ -38,17 +70,53 @@ class StaticShape:
     grounded: np.ndarray        # indices of the nodes resting on the seabed (empty without one)
     grounded_length: float      # the rope they carry [m]
     touchdown: int | None       # the grounded node next to the suspended rope, or None
+    lines: tuple[LineFigures, ...] = ()     # every line's figures (a rope: one)
+    points: tuple[PointFigures, ...] = ()   # a system's points (a rope: none)
 
 
 def equilibrium(scene: S.Scene) -> StaticShape:
     """Solve ``scene``'s static shape from its initial shape (an ``equilibrium`` start from its sagging guess)."""
     model = build(scene, solve=False)
     result = solve_equilibrium(model)
+    scene = model.scene
     x = np.ascontiguousarray(result.x)
     supports, tension = static_loads(model, x)
     grounded, length, touchdown = _on_the_seabed(model, x)
+    lines = tuple(_line_figures(model, x, line, tension[part], grounded)
+                  for line, part in zip(model.lines, line_segments(model)))
+    points = _point_figures(model, x, supports) if scene.is_system else ()
     return StaticShape(model, x.T.copy(), result.residual, result.scale, result.iterations, result.converged,
-                       model.held_idx.copy(), supports, tension, grounded, length, touchdown)
+                       model.held_idx.copy(), supports, tension, grounded, length, touchdown, lines, points)
+
+
+def _line_figures(model: Model, x: np.ndarray, line, tension: np.ndarray, grounded: np.ndarray) -> LineFigures:
+    """One line's figures (see :class:`LineFigures`) from its segments' tensions and the grounded nodes."""
+    k = int(np.argmax(tension))
+    mine = grounded[(grounded >= line.first) & (grounded < line.end)]
+    length = float(model.params.node_length[mine].sum())
+    touchdown = None
+    if mine.size and mine.size < line.nodes:
+        on = np.zeros(model.nodes, dtype=bool)
+        on[mine] = True
+        ends = [i for i in mine if (i > line.first and not on[i - 1]) or (i < line.end - 1 and not on[i + 1])]
+        touchdown = int(ends[-1]) if ends else None
+    return LineFigures(line.id, float(tension[0]), float(tension[-1]), float(tension[k]), k,
+                       int(np.count_nonzero(tension <= 0.0)), length, touchdown)
+
+
+def _point_figures(model: Model, x: np.ndarray, supports: np.ndarray) -> tuple[PointFigures, ...]:
+    """Each system point with a line end on it: where it rests and, held, the force it exerts on its ends."""
+    row = {int(node): j for j, node in enumerate(model.held_idx)}
+    out = []
+    for point in model.scene.points:
+        ends = point_ends(model.scene, model.lines)[point.id]
+        if not ends:
+            continue
+        force = None
+        if point.kind in ("fixed", "driven"):
+            force = sum(supports[row[i]] for i in ends)
+        out.append(PointFigures(point.id, point.kind, x[:, ends[0]].copy(), force))
+    return tuple(out)
 
 
 def static_loads(model: Model, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -75,7 +143,7 @@ def _on_the_seabed(model: Model, x: np.ndarray) -> tuple[np.ndarray, float, int 
     grounded = np.flatnonzero(sunk > 0.0)
     length = float(model.params.node_length[grounded].sum())
     touchdown = None
-    if grounded.size and grounded.size < model.nodes:
+    if grounded.size and grounded.size < model.nodes and not model.scene.is_system:   # a system's: per line
         lifted = sunk <= 0.0
         ends = [i for i in grounded if (i > 0 and lifted[i - 1]) or (i < model.nodes - 1 and lifted[i + 1])]
         touchdown = int(ends[-1]) if ends else None

@@ -515,6 +515,9 @@ def equilibrium(
     if out is not None:
         if out.suffix != ".toml":
             fail(f"--out {out}: must name a .toml file")
+        if scene.is_system:
+            fail(f"--out {out}: a system of lines has no 'points' start to write; give its [initial] "
+                 f"shape = \"equilibrium\" to start its runs from the static shape")
         target = _may_write(lambda: output_file(out, replace=force, force_hint=True))
     with _compiling():   # the static solver compiles on its first use
         shape = solve(scene)

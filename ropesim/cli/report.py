@@ -377,6 +377,10 @@ def print_equilibrium(shape, source: str) -> None:
                               f"({shape.residual / shape.scale:.2g} of the largest force a term puts on a node, "
                               f"{shape.scale:.4g} N)")
     axes = "xyz"[:model.dim]
+    if scene.is_system:
+        _system_equilibrium_rows(table, shape, axes)
+        _console().print(table)
+        return
     for node, force in zip(shape.held, shape.supports):
         kind = "pinned" if scene.pinned and node in {scene.node(i) for i in scene.pinned.nodes} else "driven"
         parts = ", ".join(f"F{a} = {f:.6g}" for a, f in zip(axes, force))
@@ -400,6 +404,31 @@ def print_equilibrium(shape, source: str) -> None:
     table.add_row("ends", f"node 0 at {_point(x[0])} m, the last node "
                           f"{', '.join(f'{a} {d:+.6g}' for a, d in zip(axes, span))} m from it")
     _console().print(table)
+
+
+def _system_equilibrium_rows(table, shape, axes: str) -> None:
+    """A system's rows of :func:`print_equilibrium`: each point (a support's force, a free point's position),
+    each line's tensions, and what rests on the seabed."""
+    import numpy as np
+
+    for point in shape.points:
+        where = f"{point.kind} at {_point(point.position)} m"
+        if point.force is not None:
+            parts = ", ".join(f"F{a} = {f:.6g}" for a, f in zip(axes, point.force))
+            where += f": {parts} N, |F| = {float(np.linalg.norm(point.force)):.6g} N"
+        table.add_row(f"point {point.id}", where)
+    for line in shape.lines:
+        text = (f"tension at its start {line.start_tension:.6g} N, at its end {line.end_tension:.6g} N, largest "
+                f"{line.largest:.6g} N in its segment {line.largest_segment}")
+        if line.slack:
+            text += f"; {line.slack} slack"
+        if line.grounded_length:
+            text += f"; {line.grounded_length:.6g} m on the seabed"
+            if line.touchdown is not None:
+                text += f", touchdown at node {line.touchdown}, {_point(shape.x[line.touchdown])} m"
+        table.add_row(f"line {line.id}", text)
+    if shape.model.scene.seabed is not None and not shape.grounded.size:
+        table.add_row("seabed", "no node touches it")
 
 
 def _point(p) -> str:
@@ -445,10 +474,19 @@ def equilibrium_data(shape, source: str) -> dict:
         "supports": [{"node": int(node), "kind": "pinned" if node in pinned else "driven",
                       "position_m": [float(c) for c in x[node]], "force_N": [float(f) for f in force],
                       "magnitude_N": float(np.linalg.norm(force))}
-                     for node, force in zip(shape.held, shape.supports)],
+                     for node, force in zip(shape.held, shape.supports)] if not scene.is_system else None,
         "tension_N": [float(f) for f in shape.tension],
         "positions_m": [[float(c) for c in row] for row in x],
     }
+    if scene.is_system:   # a system's supports are its fixed and driven points
+        del out["supports"]
+        out["points"] = [{"id": p.id, "kind": p.kind, "position_m": [float(c) for c in p.position]}
+                         | ({"force_N": [float(f) for f in p.force], "magnitude_N": float(np.linalg.norm(p.force))}
+                            if p.force is not None else {}) for p in shape.points]
+        out["lines"] = [{"id": line.id, "start_tension_N": line.start_tension, "end_tension_N": line.end_tension,
+                         "largest_tension_N": line.largest, "largest_segment": line.largest_segment,
+                         "slack_segments": line.slack, "grounded_length_m": line.grounded_length,
+                         "touchdown_node": line.touchdown} for line in shape.lines]
     if scene.seabed is not None:
         out["seabed"] = {"grounded_nodes": [int(i) for i in shape.grounded],
                          "grounded_length_m": float(shape.grounded_length),

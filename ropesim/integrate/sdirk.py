@@ -19,6 +19,12 @@ handles it, still O(N). Negative (compressive) geometric stiffness is left out
 of the Jacobian so the matrix stays symmetric positive definite: Newton then converges a little more slowly
 where springs are compressed, but to the same exact stage solution. Held nodes sit at x0 + V (t + c_s h) in
 every stage.
+
+A system of lines: each line's block is banded as a rope's, and the lines meet only at free points, whose line
+ends move as one (:mod:`ropesim.model.junctions`): a point's nodes share one unknown, its equation the sum of
+its nodes' (its residual folded onto its first node), and the matrix is solved with each line banded and the
+points' unknowns by a Schur complement (:mod:`ropesim.model.schur`), still O(N). Behind the compile-time
+switch of junctions: a rope compiles none of it.
 """
 
 from __future__ import annotations
@@ -31,6 +37,9 @@ import numpy as np
 
 from ..model.jacobian import Jacobian, band_width
 from ..model.forces.added_mass import added_mass_times
+from ..model.junctions import (WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_junctions,
+                               junction_added_mass_residual)
+from ..model.schur import model_groups, schur_factor, schur_solve
 from ..model.terms import (WITH_ADDED_MASS, WITH_APPLIED, accelerations, applied_accelerations, coupling_reach,
                            newton_matrix, solve_accelerations)
 from ..model.banded import factor, solve, woodbury
@@ -85,10 +94,10 @@ SDIRK2 = Sdirk("sdirk2", 2,
                "The stiff integrator: L-stable two-stage SDIRK (Alexander 1977), second order, stable at any "
                "time step; each stage a Newton solve with the rope's banded Jacobian (O(N)), drag implicit.")
 
-Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol", "step"])
+Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol", "step", "groups"])
 """The Newton solve's matrix (:class:`~ropesim.model.jacobian.Jacobian`), Woodbury arrays, right-hand side
-(N D,), whether the loop wraps around, the tolerance [m] on the largest position update, and the last update
-(N D,)."""
+(N D,), whether the loop wraps around, the tolerance [m] on the largest position update, the last update
+(N D,), and a system's groups of nodes that move as one (:class:`~ropesim.model.schur.Groups`)."""
 
 Stage = namedtuple("Stage", ["xh", "vh", "X", "V", "acc", "acc_box", "tmp"])
 """A stage's known part (xh, vh), its unknowns (X, V), the accelerations there and scratch, all (D, N)."""
@@ -106,11 +115,11 @@ class SdirkFamily(Integrator):
         super().__init__(model, grid, method)
         scene = model.scene
         dim, n = model.dim, model.nodes
-        w, cyclic = band_width(scene.rope.closed, n, coupling_reach(scene))
+        w, cyclic = band_width(any(line.closed for line in model.lines), n, coupling_reach(scene))
         nt, m = dim * n, w * dim
         jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
-        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, NEWTON_TOL * scene.rope.segment_length,
-                             np.zeros(nt))
+        tol = NEWTON_TOL * min(line.segment_length for line in model.lines)
+        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, tol, np.zeros(nt), model_groups(model, w))
         shape = (dim, n)
         self.stage = Stage(*(np.zeros(shape) for _ in Stage._fields))
         self.nodes = Nodes(np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag))
@@ -162,6 +171,10 @@ def stage_residual(stage, rhs, beta, t_stage, held, nodes, params):
             extra = added_mass_times(X, i, w0, w1, w2, params.added_mass, params.neighbours)
             for d in range(dim):
                 rhs[i * dim + d] -= extra[d]
+    if WITH_JUNCTIONS:   # a point's equation: the sum of its nodes' (with their added mass)
+        if WITH_ADDED_MASS:
+            junction_added_mass_residual(X, xh, vh, beta, rhs, params.junctions, params.neighbours)
+        fold_junctions(rhs, params.junctions, dim)
     norm = 0.0
     for u in range(rhs.shape[0]):
         norm += rhs[u] * rhs[u]
@@ -226,9 +239,16 @@ def solve_stage(stage, newton, beta, t_stage, t_piece, held, nodes, params):
         last = norm
         halvings = 0
         newton_matrix(X, V, newton.jac, beta, nodes, params, t_stage)
-        if not factor(band, newton.jac.corner, newton.cyclic, p, newton.wood):
-            return -1, 0, 0.0, 0.0, 0.0
-        solve(band, newton.jac.corner, newton.cyclic, p, rhs, newton.wood)
+        if WITH_JUNCTIONS:   # each line banded, the points' unknowns by a Schur complement
+            if WITH_ADDED_MASS:
+                add_junction_added_mass_jacobian(X, band, params.junctions, params.neighbours)
+            if not schur_factor(band, newton.jac.w, params.lines, newton.groups):
+                return -1, 0, 0.0, 0.0, 0.0
+            schur_solve(band, newton.jac.w, params.lines, newton.groups, rhs)
+        else:
+            if not factor(band, newton.jac.corner, newton.cyclic, p, newton.wood):
+                return -1, 0, 0.0, 0.0, 0.0
+            solve(band, newton.jac.corner, newton.cyclic, p, rhs, newton.wood)
         stride, worst_node = take_update(X, rhs, newton.step)
         if stride <= newton.tol:
             for d in range(dim):

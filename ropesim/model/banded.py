@@ -1,5 +1,6 @@
 """Solves with the rope's Newton matrix (the stiff integrator's and the static solver's): banded Cholesky, and
-a Woodbury correction for a loop.
+a Woodbury correction for a loop; the banded pieces a system's solve takes line by line (:mod:`ropesim.model.schur`):
+the Cholesky factorisation of a range of rows from either end, and its substitutions.
 
 The matrix is symmetric positive definite and block banded (see :mod:`ropesim.model.jacobian` for its
 storage); :func:`factor` factors it in place in O(N) and :func:`solve` solves with the factors. On a closed
@@ -32,38 +33,80 @@ def woodbury(nt: int, m: int) -> Woodbury:
 @jit.kernel
 def band_cholesky(band, p):
     """In-place Cholesky of a symmetric positive definite band matrix stored as band[q, j] = A[j + q, j]."""
+    return band_cholesky_range(band, p, 0, band.shape[1])
+
+
+@jit.kernel
+def band_solve(band, p, r):
+    """Solve L L^T z = r in place (``band`` holds L from :func:`band_cholesky`)."""
     nt = band.shape[1]
-    for j in range(nt):
+    substitute_down(band, p, r, 0, nt, 0)
+    substitute_up(band, p, r, 0, nt, nt)
+
+
+@jit.kernel
+def band_cholesky_range(band, p, r0, r1):
+    """Cholesky L L^T of rows and columns r0 .. r1 - 1 of the band matrix (``band[q, j] = A[j + q, j]``, L in
+    its place), taken on their own (a system's line: :mod:`ropesim.model.schur`)."""
+    for j in range(r0, r1):
         s = band[0, j]
-        for k in range(max(0, j - p), j):
+        for k in range(max(r0, j - p), j):
             lk = band[j - k, k]
             s -= lk * lk
         if not s > 0.0:
             return False
         djj = math.sqrt(s)
         band[0, j] = djj
-        for i in range(j + 1, min(nt, j + p + 1)):
+        for i in range(j + 1, min(r1, j + p + 1)):
             s = band[i - j, j]
-            for k in range(max(0, i - p), j):
+            for k in range(max(r0, i - p), j):
                 s -= band[i - k, k] * band[j - k, k]
             band[i - j, j] = s / djj
     return True
 
 
 @jit.kernel
-def band_solve(band, p, r):
-    """Solve L L^T z = r in place (``band`` holds L from :func:`_band_cholesky`)."""
-    nt = band.shape[1]
-    for i in range(nt):
-        s = r[i]
-        for k in range(max(0, i - p), i):
-            s -= band[i - k, k] * r[k]
-        r[i] = s / band[0, i]
-    for i in range(nt - 1, -1, -1):
-        s = r[i]
-        for k in range(i + 1, min(nt, i + p + 1)):
-            s -= band[k - i, i] * r[k]
-        r[i] = s / band[0, i]
+def band_cholesky_reverse(band, p, r0, r1):
+    """The factorisation U U^T (U upper banded) of rows and columns r0 .. r1 - 1, from the last row up: U[i, j]
+    (i <= j) takes A[j, i]'s place, ``band[j - i, i]``. The Cholesky factorisation of the rows in reverse
+    order."""
+    for j in range(r1 - 1, r0 - 1, -1):
+        s = band[0, j]
+        for k in range(j + 1, min(r1, j + p + 1)):
+            uk = band[k - j, j]
+            s -= uk * uk
+        if not s > 0.0:
+            return False
+        djj = math.sqrt(s)
+        band[0, j] = djj
+        for i in range(j - 1, max(r0, j - p) - 1, -1):
+            s = band[j - i, i]
+            for k in range(j + 1, min(r1, i + p + 1)):
+                s -= band[k - i, i] * band[k - j, j]
+            band[j - i, i] = s / djj
+    return True
+
+
+@jit.kernel
+def substitute_down(band, p, z, r0, r1, lo):
+    """z[i] <- (z[i] - sum_(k<i) band[i - k, k] z[k]) / band[0, i] for i = lo .. r1 - 1, rows r0 .. lo - 1 of z
+    being zero: L^-1 z after :func:`band_cholesky_range`, U^-T z after :func:`band_cholesky_reverse`."""
+    for i in range(lo, r1):
+        s = z[i]
+        for k in range(max(lo, r0, i - p), i):
+            s -= band[i - k, k] * z[k]
+        z[i] = s / band[0, i]
+
+
+@jit.kernel
+def substitute_up(band, p, z, r0, r1, hi):
+    """z[i] <- (z[i] - sum_(k>i) band[k - i, i] z[k]) / band[0, i] for i = hi - 1 down to r0, rows hi .. r1 - 1
+    of z being zero: L^-T z after :func:`band_cholesky_range`, U^-1 z after :func:`band_cholesky_reverse`."""
+    for i in range(hi - 1, r0 - 1, -1):
+        s = z[i]
+        for k in range(i + 1, min(hi, r1, i + p + 1)):
+            s -= band[k - i, i] * z[k]
+        z[i] = s / band[0, i]
 
 
 @jit.kernel
@@ -71,19 +114,32 @@ def band_solve_columns(band, p, z):
     """Solve L L^T Z = z in place for every column of ``z`` (nt, m) at once: the same operations, in the same
     order, as :func:`band_solve` on each column, with each entry of L loaded once for all columns."""
     nt, m = z.shape
-    for i in range(nt):
-        for k in range(max(0, i - p), i):
+    substitute_columns_down(band, p, z, 0, nt, 0, 0, m)
+    substitute_columns_up(band, p, z, 0, nt, nt, 0, m)
+
+
+@jit.kernel
+def substitute_columns_down(band, p, z, r0, r1, lo, c0, c1):
+    """:func:`substitute_down` on columns c0 .. c1 - 1 of ``z`` (rows, columns) at once, each entry of the
+    factor loaded once for all of them."""
+    for i in range(lo, r1):
+        for k in range(max(lo, r0, i - p), i):
             lik = band[i - k, k]
-            for c in range(m):
+            for c in range(c0, c1):
                 z[i, c] -= lik * z[k, c]
-        for c in range(m):
+        for c in range(c0, c1):
             z[i, c] /= band[0, i]
-    for i in range(nt - 1, -1, -1):
-        for k in range(i + 1, min(nt, i + p + 1)):
+
+
+@jit.kernel
+def substitute_columns_up(band, p, z, r0, r1, hi, c0, c1):
+    """:func:`substitute_up` on columns c0 .. c1 - 1 of ``z`` (rows, columns) at once."""
+    for i in range(hi - 1, r0 - 1, -1):
+        for k in range(i + 1, min(hi, r1, i + p + 1)):
             lki = band[k - i, i]
-            for c in range(m):
+            for c in range(c0, c1):
                 z[i, c] -= lki * z[k, c]
-        for c in range(m):
+        for c in range(c0, c1):
             z[i, c] /= band[0, i]
 
 

@@ -16,7 +16,9 @@ bit without being copied. The power of the fluid's inertial force on the point, 
 is booked as fluid work, as a node's added mass is.
 
 The stiff integrator's Newton solve and the static solver treat a point's nodes as one: its junction's nodes
-share one unknown (:mod:`ropesim.integrate.sdirk`).
+share one unknown, solved for through a Schur complement (:mod:`ropesim.model.schur`); the point's equation is
+the sum of its nodes' (:func:`fold_junctions`), with the added mass this module keeps out of the per-node pass
+(:func:`junction_added_mass_residual`, :func:`add_junction_added_mass_jacobian`).
 
 Parameters: ``Junctions`` = (start (J + 1,) int64, nodes (K,) int64: junction j's nodes are
 ``nodes[start[j]:start[j + 1]]``, the point's own first; added (2, K): each node's added-mass coefficients
@@ -111,3 +113,51 @@ def move_junctions(x, v, acc, inv_mass, junctions, around):
         if dim == 3:
             power += (inertia * a2 - f2) * v[2, first]
     return power
+
+
+@jit.kernel
+def fold_junctions(rhs, junctions, dim):
+    """Sum each junction's rows of ``rhs`` (flat, node-major: a residual or a force per node) into its first
+    node's and zero the others': the point's one equation, as :func:`move_junctions` sums its forces."""
+    start, nodes = junctions.start, junctions.nodes
+    for j in range(start.shape[0] - 1):
+        first = nodes[start[j]]
+        for k in range(start[j] + 1, start[j + 1]):
+            i = nodes[k]
+            for d in range(dim):
+                rhs[first * dim + d] += rhs[i * dim + d]
+                rhs[i * dim + d] = 0.0
+
+
+@jit.kernel
+def junction_added_mass_residual(x, xh, vh, beta, rhs, junctions, around):
+    """Subtract A_k (x - xh - beta vh) at every junction node from the stiff integrator's residual ``rhs``
+    (flat, node-major): the added mass of the point's nodes, which the per-node pass leaves to this module."""
+    start, nodes, added = junctions
+    dim = x.shape[0]
+    for k in range(nodes.shape[0]):
+        i = nodes[k]
+        a_n, a_t = added[0, k], added[1, k]
+        if a_n == 0.0 and a_t == 0.0:
+            continue
+        q = node_tangent(x, i, around)
+        w = (x[0, i] - xh[0, i] - beta * vh[0, i], x[1, i] - xh[1, i] - beta * vh[1, i],
+             x[2, i] - xh[2, i] - beta * vh[2, i] if dim == 3 else 0.0)
+        along = w[0] * q[0] + w[1] * q[1] + w[2] * q[2]
+        for d in range(dim):
+            rhs[i * dim + d] -= a_n * (w[d] - along * q[d]) + a_t * along * q[d]
+
+
+@jit.kernel
+def add_junction_added_mass_jacobian(x, band, junctions, around):
+    """Add each junction node's added-mass block A_k = a_n (I - q q^T) + a_t q q^T to the Newton matrix's band
+    (the tangent frozen, as :func:`ropesim.model.forces.added_mass.add_added_mass_jacobian` does per node)."""
+    start, nodes, added = junctions
+    dim = x.shape[0]
+    for k in range(nodes.shape[0]):
+        i = nodes[k]
+        q = node_tangent(x, i, around)
+        for a in range(dim):
+            for b in range(a + 1):
+                qq = q[a] * q[b]
+                band[a - b, i * dim + b] += added[0, k] * ((1.0 if a == b else 0.0) - qq) + added[1, k] * qq

@@ -23,6 +23,11 @@ one keeps it, a failed one quarters it; no node moves more than a segment in one
 Jacobian is only local). Near the solution, where the energy's changes reach its round-off, a step is also
 taken when it halves the residual. The banded solves make each iteration O(N).
 
+A system of lines is solved the same way: a free point's line ends share one unknown and its balance is the sum
+of the forces on them (:func:`~ropesim.model.junctions.fold_junctions`), the step solved with each line banded
+and the points' unknowns by a Schur complement (:mod:`ropesim.model.schur`). The pseudo-time step starts at the
+stiffest line's spring period, and no node moves more than the shortest segment in one step.
+
 Drag in a flow depends on positions too, through each node's tangent (the split into normal and tangential
 drag): K_t = -dF_drag/dx (:func:`ropesim.model.forces.fluid.add_fluid_tangent_stiffness`), which the
 integrator's symmetric matrix leaves out. For a line hanging in a current it is as large as the springs'
@@ -48,6 +53,8 @@ from .banded import solve as solve_newton_matrix
 from .banded import woodbury
 from .jacobian import Jacobian, band_width
 from .forces.fluid import WITH_FLUID_DRAG, WITH_VISCOUS_DRAG, add_fluid_tangent_stiffness
+from .junctions import WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_junctions
+from .schur import model_groups, schur_factor, schur_solve
 from .terms import accelerations, coupling_reach, mechanical_energy, newton_matrix, velocity_accelerations
 from . import jit
 
@@ -70,17 +77,20 @@ class Equilibrium:
 
 @jit.kernel
 def forces_on_free_nodes(x, v, acc, p, t, mass, free, out):
-    """The net static force [N] on every free node (0 on held nodes) into ``out`` (flat, node-major); returns
-    its largest component."""
+    """The net static force [N] on every free node (0 on held nodes) into ``out`` (flat, node-major), a free
+    point's on its first node (the sum over its line ends, the others 0); returns its largest component."""
     accelerations(x, v, acc, p, t)
     dim, n = x.shape
-    worst = 0.0
     for i in range(n):
         for d in range(dim):
-            f = mass[i] * acc[d, i] if free[i] else 0.0
-            out[i * dim + d] = f
-            if abs(f) > worst or not f == f:
-                worst = abs(f) if f == f else np.inf
+            out[i * dim + d] = mass[i] * acc[d, i] if free[i] else 0.0
+    if WITH_JUNCTIONS:
+        fold_junctions(out, p.junctions, dim)
+    worst = 0.0
+    for u in range(out.shape[0]):
+        f = out[u]
+        if abs(f) > worst or not f == f:
+            worst = abs(f) if f == f else np.inf
     return worst
 
 
@@ -98,25 +108,47 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     v = np.zeros_like(x)
     acc = np.zeros_like(x)
     t = _steady_time(scene)
-    w, cyclic = band_width(scene.rope.closed, n, coupling_reach(scene))
+    w, cyclic = band_width(any(line.closed for line in model.lines), n, coupling_reach(scene))
     nt, m = dim * n, w * dim
     jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
     wood = woodbury(nt, m)
+    groups = model_groups(model, w)
+    if groups.nodes.size:   # a system's free points: each line banded, the points by a Schur complement
+        def factored() -> bool:
+            add_junction_added_mass_jacobian(x, jac.band, p.junctions, p.neighbours)
+            return schur_factor(jac.band, w, p.lines, groups)
+
+        def inverse(z: np.ndarray) -> None:
+            schur_solve(jac.band, w, p.lines, groups, z)
+
+        def folded(z: np.ndarray) -> np.ndarray:
+            fold_junctions(z, p.junctions, dim)
+            return z
+    else:
+        def factored() -> bool:
+            return factor(jac.band, jac.corner, cyclic, jac.band.shape[0] - 1, wood)
+
+        def inverse(z: np.ndarray) -> None:
+            solve(jac.band, jac.corner, cyclic, jac.band.shape[0] - 1, z, wood)
+
+        def folded(z: np.ndarray) -> np.ndarray:
+            return z
     nodes = (free, mass, np.where(model.held, 0.0, model.drag))
     force, trial, other = np.zeros(nt), np.zeros(nt), np.zeros(nt)
     scale = _force_scale(model)
     worst = static_force(x, v, acc, p, t, mass, free, force)
     norm = float(np.linalg.norm(force))
     energy = float(energy_of(x, v, mass, p)[0])
-    tau = math.sqrt(float(mass[free].min()) / max(scene.rope.stiffness, 1e-300))   # one spring's period
-    reach = scene.rope.segment_length
+    stiffest = max(line.stiffness for line in model.lines)
+    tau = math.sqrt(float(mass[free].min()) / max(stiffest, 1e-300))   # one spring's period
+    reach = min(line.segment_length for line in model.lines)
     dragged = {WITH_FLUID_DRAG.name, WITH_VISCOUS_DRAG.name} & model.switches
     blocks = np.zeros((n, 3, dim, dim)) if dragged else None
     for iteration in range(1, max_iterations + 1):
         if worst <= tol * scale:
             return Equilibrium(x, worst, scale, iteration - 1, True)
         jacobian(x, v, jac, tau, nodes, p, t)   # M + tau b + tau^2 K + tau C, so the step is tau^2 F
-        if not factor(jac.band, jac.corner, cyclic, jac.band.shape[0] - 1, wood):
+        if not factored():
             tau *= 0.25
             continue
         step = force * tau * tau
@@ -124,10 +156,9 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
             blocks[:] = 0.0
             tangent_stiffness(x, v, blocks, free, p, t)
         if blocks is None or not blocks.any():
-            solve(jac.band, jac.corner, cyclic, jac.band.shape[0] - 1, step, wood)
+            inverse(step)
         else:
-            step = _krylov_step(step, lambda z: solve(jac.band, jac.corner, cyclic, jac.band.shape[0] - 1, z, wood),
-                                lambda z: tau * tau * _apply_blocks(blocks, z, free))
+            step = _krylov_step(step, inverse, lambda z: tau * tau * folded(_apply_blocks(blocks, z, free)))
         largest = float(np.abs(step).max())
         if largest > reach:
             step *= reach / largest
@@ -207,7 +238,7 @@ def _krylov_step(rhs: np.ndarray, inverse, extra) -> np.ndarray:
 @jit.kernel
 def nonconservative_forces(x, v, acc, p, t, mass, free, out):
     """The force [N] of the terms that are not conservative (drag in the flow; the others vanish at rest) on
-    every free node into ``out`` (flat, node-major)."""
+    every free node into ``out`` (flat, node-major), a free point's on its first node."""
     dim, n = x.shape
     for i in range(n):
         for d in range(dim):
@@ -216,6 +247,8 @@ def nonconservative_forces(x, v, acc, p, t, mass, free, out):
     for i in range(n):
         for d in range(dim):
             out[i * dim + d] = mass[i] * acc[d, i] if free[i] else 0.0
+    if WITH_JUNCTIONS:
+        fold_junctions(out, p.junctions, dim)
 
 
 def _steady_time(scene) -> float:
@@ -225,7 +258,7 @@ def _steady_time(scene) -> float:
 
 def _force_scale(model) -> float:
     """The largest force [N] a term puts on a node: its weight (g or 1 m/s^2 times its mass), or a segment's
-    pull at 1 % strain."""
+    pull at 1 % strain (the stiffest line's)."""
     scene = model.scene
     g = scene.gravity.g if scene.gravity is not None else 1.0
-    return max(float(model.mass.max()) * g, 0.01 * scene.rope.stiffness * scene.rope.segment_length)
+    return max(float(model.mass.max()) * g, 0.01 * max(line.stiffness * line.segment_length for line in model.lines))
