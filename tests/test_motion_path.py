@@ -23,7 +23,7 @@ def _motion(times: np.ndarray, rows: np.ndarray) -> Motion:
     k = times.size
     z = np.zeros((2, 1))
     return Motion(True, z, z.copy(), z.copy(), z.copy(), np.zeros(1), times, np.vstack([rows, np.zeros(k)]),
-                  np.array([[0, k]], dtype=np.int64), z.copy(), np.full(1, -1, dtype=np.int64), np.zeros((3, 1)), None)
+                  np.array([[0, k]], dtype=np.int64), z.copy(), None, None, None)
 
 
 def _linear_walk(times, rows, t):

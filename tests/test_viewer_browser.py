@@ -219,3 +219,38 @@ def test_every_built_in_scene_at_its_full_length(browser, name, tmp_path):
     assert np.abs(shown - np.asarray(traj.x[-1])).max() <= info["bound"] * (1 + 1e-6)
     assert drawn_fraction(picture(opened.canvas_png())) > 0.003
     opened.page.close()
+
+
+def test_a_system_shows_each_line_and_its_bodies_box(browser, tmp_path):
+    """A real system (the clump weight) and a made-up spar turning as it drifts: each line's positions and the
+    body's box pose read back from the page as the run has them."""
+    from conftest import ROOT
+    from synthetic_system import turning_body_run
+
+    systems = ROOT / "tests" / "data" / "systems"
+    clump = ropesim.simulate(ropesim.load_scene(systems / "clump_weight.toml", ["integrator.t_end=0.5"]),
+                             tmp_path / "clump")
+    write_page(clump.folder, tmp_path / "clump.html")
+    opened = browser.open(tmp_path / "clump.html")
+    assert_clean(opened)
+    (info,) = opened.info()
+    assert [(line["name"], line["nodes"]) for line in info["lines"]] == [("left_wire", 11), ("right_wire", 11)]
+    assert info["points"] == ["fixed point", "clump 200 kg"]
+    for frame in (0, 30):
+        opened.page.evaluate(f"window.ropesim.setFrame({frame})")
+        for k, line in enumerate(("left_wire", "right_wire")):
+            shown = np.array(opened.page.evaluate(f"window.ropesim.positions(0, {k})"))
+            assert np.abs(shown - clump.line(line).positions[frame]).max() <= info["bound"] * (1 + 1e-6)
+    spar = turning_body_run(ropesim.load_scene(systems / "oc3_hywind.toml"), frames=12)
+    spar.view().save(tmp_path / "spar.html")
+    opened = browser.open(tmp_path / "spar.html")
+    assert_clean(opened)
+    assert opened.info()[0]["bodies"] == ["spar"]
+    body = spar.body("spar")
+    centre = np.array([1.3, -35.0, 0.0])           # the middle of the box round (0, 0, 0) and the fairleads
+    for frame in (0, 7):
+        opened.page.evaluate(f"window.ropesim.setFrame({frame})")
+        pose = opened.page.evaluate("window.ropesim.bodyPose(0, 0)")
+        assert np.allclose(pose["position"], body.position[frame] + body.rotation[frame] @ centre, atol=1e-4)
+        assert np.allclose(pose["quaternion"], body.quaternion[frame], atol=1e-6)
+    assert drawn_fraction(picture(opened.canvas_png())) > 0.003

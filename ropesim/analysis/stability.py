@@ -39,6 +39,8 @@ def representatives(model: Model) -> np.ndarray:
     """Each node's representative (N,) int: itself, or for the line ends on a system's free point the point's
     first (they move as one, :mod:`ropesim.model.junctions`)."""
     rep = np.arange(model.nodes)
+    if model.params.junctions is None:
+        return rep
     start, nodes = model.params.junctions.start, model.params.junctions.nodes
     for j in range(len(start) - 1):
         group = nodes[start[j]:start[j + 1]]
@@ -85,7 +87,7 @@ def inertial_mass(model: Model) -> np.ndarray:
     added = model.params.added_mass
     mass = model.mass + added.min(axis=0) if added.size else model.mass
     junctions = model.params.junctions
-    if junctions.nodes.size:
+    if junctions is not None:
         rep = representatives(model)
         together = np.zeros(model.nodes)
         np.add.at(together, rep, mass)
@@ -228,7 +230,8 @@ def probe(scene, method: str, dt: float, steps: int = PROBE_STEPS) -> bool:
     model = build(scene)
     rng = np.random.default_rng(12345)
     free = ~model.held
-    model.x0[:, free] += PERTURBATION * scene.rope.segment_length * rng.standard_normal((model.dim, free.sum()))
+    spacing = min(line.segment_length for line in model.lines)
+    model.x0[:, free] += PERTURBATION * spacing * rng.standard_normal((model.dim, free.sum()))
     grid = TimeGrid.of(scene)
     stepper = make_integrator(model, grid, method)
     _, _, status, _ = advance_in_chunks(stepper, grid.steps)   # Ctrl-C is honoured between chunks
@@ -289,10 +292,18 @@ def stability_sweep(scene, methods=None, fractions=None, stiffnesses=None, steps
 
     methods = list(methods or METHODS)
     fractions = fractions or [round(0.1 * i, 2) for i in range(1, 21)]
+    if scene.is_system:    # each line has its own k: the scene as it is, labelled by its stiffest line's
+        if stiffnesses:
+            raise ValueError("--k: a system's lines each have their own stiffness EA / l; sweep one with --set "
+                             "(lines.N.EA=..., or line_types.NAME.EA=...)")
+        from ..model.layout import line_layouts
+
+        stiffnesses = [max(line.stiffness for line in line_layouts(scene))]
     stiffnesses = stiffnesses or [scene.rope.stiffness]
     rows, bound_rows = [], []
     for k in stiffnesses:
-        sc = dataclasses.replace(scene, rope=dataclasses.replace(scene.rope, stiffness=k))
+        sc = scene if scene.is_system else dataclasses.replace(scene, rope=dataclasses.replace(scene.rope,
+                                                                                             stiffness=k))
         model = build(sc)
         unit = reference_dt(model)
         g, s = gershgorin_frequency(model), spectral_frequency(model)

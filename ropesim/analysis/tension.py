@@ -75,22 +75,70 @@ def window_statistics(values, frames: slice, block: int = 256) -> dict[str, np.n
 def windowed_figures(traj, start: float | None = None, stop: float | None = None) -> dict:
     """The tension and support figures of a run over the window [start, stop] [s] (the whole run by default):
     per segment min / max / mean / std of tension [N], the two end tensions' and each support force
-    magnitude's, the largest tension with where and when, and the unit to print them in."""
+    magnitude's, the largest tension with where and when, and the unit to print them in. A rope's are at the
+    top level; a system's per line, under ``lines`` by line id (its segments numbered from its start), with
+    ``support_labels`` naming each support by its point and line end."""
+    from ..model.layout import line_layouts
+
     frames = frame_window(traj.t, start, stop)
     t = np.asarray(traj.t[frames])
-    along = window_statistics(traj.tension, frames)
-    k, j = np.unravel_index(int(np.argmax(np.asarray(traj.tension[frames]))), (len(t), traj.tension.shape[1]))
-    out = {"from_s": float(f"{float(t[0]):.12g}"), "to_s": float(f"{float(t[-1]):.12g}"), "frames": int(len(t)),
-           "segments": {name: values.tolist() for name, values in along.items()},
-           "start": {name: float(values[0]) for name, values in along.items()},
-           "end": {name: float(values[-1]) for name, values in along.items()},
-           "max_N": float(traj.tension[frames.start + k, j]), "max_segment": int(j),
-           "max_t_s": float(f"{float(t[k]):.12g}")}
-    largest = float(np.max(np.abs(along["max"])))
+    out = {"from_s": float(f"{float(t[0]):.12g}"), "to_s": float(f"{float(t[-1]):.12g}"), "frames": int(len(t))}
+    lines, first = {}, 0
+    for line in line_layouts(traj.scene):
+        lines[line.id] = _line_window(traj.tension[:, first:first + line.segments], t, frames)
+        first += line.segments
+    if traj.scene.is_system:
+        out["lines"] = lines
+    else:
+        out.update(lines["rope"])
+    largest = max(float(np.max(np.abs(figures["segments"]["max"]))) for figures in lines.values())
     if traj.support is not None:
         magnitude = np.linalg.norm(np.asarray(traj.support[frames]), axis=2)
         stats = window_statistics(magnitude, slice(0, len(t)))
         out["supports"] = [{name: float(values[h]) for name, values in stats.items()} for h in range(magnitude.shape[1])]
+        if traj.scene.is_system:
+            from ..model.build import build
+
+            out["support_labels"] = support_labels(traj.scene, build(traj.scene, solve=False).held_idx)
         largest = max(largest, float(stats["max"].max()))
     out["unit"] = force_unit(largest)[0]
     return out
+
+
+def _line_window(tension, t: np.ndarray, frames: slice) -> dict:
+    """One line's figures over ``frames``: per segment statistics, its two ends', the largest with where and
+    when (``tension`` (F, S) [N], all frames; ``t`` the window's times)."""
+    along = window_statistics(tension, frames)
+    k, j = np.unravel_index(int(np.argmax(np.asarray(tension[frames]))), (len(t), tension.shape[1]))
+    return {"segments": {name: values.tolist() for name, values in along.items()},
+            "start": {name: float(values[0]) for name, values in along.items()},
+            "end": {name: float(values[-1]) for name, values in along.items()},
+            "max_N": float(tension[frames.start + k, j]), "max_segment": int(j),
+            "max_t_s": float(f"{float(t[k]):.12g}")}
+
+
+def end_columns(model) -> list[tuple[str, int]]:
+    """(label, column in the frames' tension array) of every line end: a rope's "segment 0 (at node 0)" and its
+    last segment's; a system's "LINE start (POINT)" and "LINE end (POINT)"."""
+    from ..model.tension import line_segments
+
+    if not model.scene.is_system:
+        last = sum(line.segments for line in model.lines) - 1
+        return [("segment 0 (at node 0)", 0)] + ([(f"segment {last} (the other end)", last)] if last > 0 else [])
+    out = []
+    for line, part in zip(model.scene.lines, line_segments(model)):
+        out += [(f"{line.id} start ({line.start})", part.start), (f"{line.id} end ({line.end})", part.stop - 1)]
+    return out
+
+
+def support_labels(scene, held) -> list[str]:
+    """A system's supports, its held nodes ``held`` (in node order: a fixed or driven point's line ends, and
+    those on a fixed or driven body's points), each by the point that holds it and the line end there:
+    "anchor1 (line1's start)"."""
+    from ..model.layout import line_layouts
+
+    ends = {}
+    for line, layout in zip(scene.lines, line_layouts(scene)):
+        ends[layout.first] = f"{line.start} ({line.id}'s start)"
+        ends[layout.end - 1] = f"{line.end} ({line.id}'s end)"
+    return [ends.get(int(node), f"node {int(node)}") for node in held]

@@ -657,11 +657,13 @@ def _sweep_start(count: int, root: Path, quiet: bool, yes: bool) -> None:
 
 RunDirArg = Annotated[Path, typer.Argument(metavar="RUN_DIR", help="Run folder written by `ropesim run`, e.g. "
                                                                    "runs/helicopter_mass.", show_default=False)]
-FollowOpt = Annotated[bool, typer.Option("--follow", help="View from the driven node (the helicopter): "
-                                                          "positions relative to it.")]
+FollowOpt = Annotated[bool, typer.Option("--follow", help="View from the driven node (the helicopter; a "
+                                                          "system's driven points and bodies): positions "
+                                                          "relative to it.")]
 ViewOpt = Annotated[Optional[str], typer.Option(
-    "--view", help="3-D scenes: the axes shown across and up: xy (side view, default), xz (from above), "
-                   "zy (from the front).", show_default=False)]
+    "--view", help="3-D scenes: the axes shown across and up: xy (side view, the default for one rope), xz "
+                   "(from above), zy (from the front); or 3d, a view in 3-D axes (the default for a system "
+                   "of lines).", show_default=False)]
 
 
 def _check_fps(fps: float) -> float:
@@ -960,6 +962,11 @@ def export(
     STEM_tension_range.csv (per segment: min, max, mean and std of its tension), in kN where forces reach
     kilonewtons; --from/--until keep a window (leave the ramp-in out).
 
+    A system of lines: in VTK each line is a block of its own, named by its id, and rigid bodies are glyphs (their
+    axes and spokes to their points, with the force and moment of their lines); in CSV each row names its line,
+    the force tables go by line end and support point, and STEM_bodies.csv holds each body's pose, velocities,
+    force and moment per frame.
+
     NetCDF is not offered: xarray with h5py would add about 120 MB to hold the three arrays trajectory.npz
     already holds (numpy.load reads it; xarray wraps it in one call).
     """
@@ -991,7 +998,9 @@ def _warn_ladder(scene, steps: dict[str, float], command: str) -> None:
 
     total = sum(steps.values())
     if total >= LADDER_WARN_STEPS:
-        seconds = 1e-9 * scene.rope.nodes * sum(n * NS_PER_NODE_STEP.get(m, 1000.0) for m, n in steps.items())
+        from ..io.trajectory import scene_nodes
+
+        seconds = 1e-9 * scene_nodes(scene) * sum(n * NS_PER_NODE_STEP.get(m, 1000.0) for m, n in steps.items())
         typer.echo(f"ropesim: warning: {command}: about {total:.2g} steps in all, about {_duration(seconds)} of "
                    f"computing; Ctrl-C stops it", err=True)
 
@@ -1111,6 +1120,8 @@ def stability(
             result = stability_sweep(scene, names, ladder, ks, steps)
     except (KeyboardInterrupt, Stopped) as exc:
         fail("stability interrupted; nothing written", exit_code(exc))
+    except ValueError as exc:
+        fail(str(exc))
     try:
         write_sweep(result, files[0].parent)
         plot_sweep(result, files[2])

@@ -125,6 +125,16 @@ def summary_rows(summary: dict) -> list[tuple[str, str]]:
         rows.append(("tension", f"{tension['start_N']:.4g} N at node 0's end, {tension['end_N']:.4g} N at the "
                                 f"other at t_end; largest {tension['max_N']:.4g} N (segment {tension['max_segment']}, "
                                 f"t = {tension['max_t_s']:.3g} s)"))
+    lines = summary.get("lines") or {}
+    if lines:
+        from ..analysis.tension import force_unit
+
+        unit, scale = force_unit(max(abs(figures["max_N"]) for figures in lines.values()))
+    for line, figures in lines.items():
+        rows.append((f"tension, {line}", f"{figures['start_N'] / scale:.4g} {unit} at its start, "
+                                         f"{figures['end_N'] / scale:.4g} {unit} at its end at t_end; largest "
+                                         f"{figures['max_N'] / scale:.4g} {unit} (its segment "
+                                         f"{figures['max_segment']}, t = {figures['max_t_s']:.3g} s)"))
     ledger = summary.get("energy_ledger")
     if ledger:
         flows = [f"{what} {ledger[key]:.4g} J" for what, key in (("drag took", "drag_loss_J"),
@@ -160,25 +170,22 @@ def print_check(scene: Scene, source: Path) -> None:
 
     model = build(scene)
     grid = TimeGrid.of(scene)
-    rope = scene.rope
     table = Table(title=f"{source}: valid scene '{scene.name}'", show_header=False, title_justify="left")
     table.add_column("", style="bold")
     table.add_column("", overflow="fold")  # words wrap; a word too long for the column folds, never cut
     if scene.description:
         table.add_row("description", scene.description)
-    table.add_row("rope", f"{rope.nodes} nodes, {'closed loop' if rope.closed else 'open line'}, "
-                          f"{scene.dimension}-D; l = {rope.segment_length:g} m, k = {rope.stiffness:g} N/m, "
-                          f"m = {rope.mass:g} kg" + (f" (the ends {rope.mass / 2:g} kg)" if rope.physical
-                                                       and not rope.closed else "")
-                          + ("" if rope.compression else "; slack in compression"))
-    if rope.physical:
-        table.add_row("physical form", f"{rope.length:g} m in {rope.segments} segments, {rope.mass_per_length:g} "
-                                       f"kg/m, EA = {rope.EA:g} N"
-                                       + (f", d = {rope.diameter:g} m" if rope.diameter else ""))
+    for key, value in (system_rows(scene, model) if scene.is_system else rope_rows(scene)):
+        table.add_row(key, value)
     init = scene.initial
-    moving = ("a velocity per node" if getattr(init, "velocities", None) is not None
-              else f"velocity {list(init.velocity)} m/s")
-    table.add_row("initial", f"{init.shape}, {moving}")
+    if scene.is_system:
+        table.add_row("initial", f"{init.shape}: " + ("every line straight or sagging from its start point to its "
+                                                      "end point, at rest" if init.shape == "lines" else
+                                                      "the static shape, solved before the run"))
+    else:
+        moving = ("a velocity per node" if getattr(init, "velocities", None) is not None
+                  else f"velocity {list(init.velocity)} m/s")
+        table.add_row("initial", f"{init.shape}, {moving}")
     table.add_row("force terms", ", ".join(force_terms(scene, model)))
     held = []
     if scene.pinned:
@@ -199,12 +206,98 @@ def print_check(scene: Scene, source: Path) -> None:
     _console().print(table)
 
 
+def rope_rows(scene: Scene) -> list[tuple[str, str]]:
+    """The check table's rows of what one rope is made of."""
+    rope = scene.rope
+    rows = [("rope", f"{rope.nodes} nodes, {'closed loop' if rope.closed else 'open line'}, "
+                     f"{scene.dimension}-D; l = {rope.segment_length:g} m, k = {rope.stiffness:g} N/m, "
+                     f"m = {rope.mass:g} kg" + (f" (the ends {rope.mass / 2:g} kg)" if rope.physical
+                                                  and not rope.closed else "")
+                     + ("" if rope.compression else "; slack in compression"))]
+    if rope.physical:
+        rows.append(("physical form", f"{rope.length:g} m in {rope.segments} segments, {rope.mass_per_length:g} "
+                                      f"kg/m, EA = {rope.EA:g} N" + (f", d = {rope.diameter:g} m" if rope.diameter
+                                                                     else "")))
+    return rows
+
+
+def system_rows(scene: Scene, model) -> list[tuple[str, str]]:
+    """The check table's rows of what a system is made of: its size, then each line, point and rigid body."""
+    count = lambda n, what: f"{n} {what}{'s' if n != 1 else ''}"   # noqa: E731
+    bodies = len(scene.rigid_bodies)
+    rows = [("system", f"{count(len(scene.lines), 'line')}, {count(len(scene.points), 'point')}"
+                       + (f", {bodies} rigid bod{'ies' if bodies != 1 else 'y'}" if bodies else "")
+                       + f", {scene.dimension}-D; {model.nodes} nodes")]
+    for line, layout in zip(scene.lines, model.lines):
+        material = [f"{line.mass_per_length:g} kg/m", f"EA = {line.EA:g} N"]
+        material += [f"{name} = {value:g} {unit}" for name, value, unit in
+                     (("d", line.diameter, "m"), ("BA", line.axial_damping, "N s"), ("EI", line.EI, "N m^2"))
+                     if value]
+        kind = f"{line.type}: " if line.type else ""
+        rows.append((f"line {line.id}", f"{line.start} -> {line.end}, {line.length:g} m in {line.segments} segments "
+                                        f"(nodes {layout.first} .. {layout.end - 1}); {kind}{', '.join(material)}"
+                                        + ("" if layout.slack else "; pushes back in compression")))
+    for point in scene.points:
+        rows.append((f"point {point.id}", _point_text(point)))
+    for body in scene.rigid_bodies:
+        rows.append((f"body {body.id}", _body_text(body, scene)))
+    return rows
+
+
+def _point_text(point) -> str:
+    """A system point in a phrase: its kind, where it is, what it carries or how it moves."""
+    where = _point(point.position)
+    if point.kind == "body":
+        return f"on body {point.body}, at {where} m in its frame"
+    if point.kind == "free":
+        parts = [f"{point.mass:g} kg" if point.mass else "no mass of its own"]
+        parts += [f"{name} {value:g}{unit}" for name, value, unit in (("volume", point.volume, " m^3"),
+                                                                       ("CdA", point.cd_area, " m^2"),
+                                                                       ("Ca", point.ca, "")) if value]
+        return f"free, starting at {where} m; {', '.join(parts)}"
+    if point.kind == "driven":
+        return f"driven from {where} m " + _motion_text(point)
+    return f"fixed at {where} m"
+
+
+DOF_NAMES = ("x", "y", "z", "rx", "ry", "rz")
+
+
+def _body_text(body, scene: Scene) -> str:
+    """A rigid body in a phrase: its kind, where it starts, its mass and how it moves."""
+    dim = scene.dimension
+    turned = any(body.orientation or ())
+    parts = [f"{body.kind}, reference point at {_point(body.position)} m"
+             + (f", turned {_point(body.orientation)} deg" if turned else "")]
+    if body.mass:
+        parts.append(f"{body.mass:g} kg")
+    if body.volume:
+        parts.append(f"volume {body.volume:g} m^3")
+    on = [p.id for p in scene.points if p.kind == "body" and p.body == body.id]
+    parts.append(f"points {', '.join(on)}" if on else "no points")
+    text = "; ".join(parts)
+    if body.kind == "driven":
+        names = DOF_NAMES if dim == 3 else ("x", "y", "rz")
+        units = ["m"] * dim + ["deg"] * (len(names) - dim)
+        axes = [f"{names[k]} {a:g} {units[k]}, {body.period[k]:g} s" for k, a in enumerate(body.amplitude or ()) if a]
+        moves = []
+        if any(body.velocity or ()) or any(body.angular_velocity or ()):
+            moves.append(f"at {list(body.velocity)} m/s, {list(body.angular_velocity)} deg/s")
+        if axes:
+            moves.append("sinusoid " + "; ".join(axes))
+        if body.path_table is not None:
+            moves.append(f"a path of {len(body.path_table)} rows")
+        ramp = f", ramped in over {body.ramp_time:g} s" if body.ramp_time and (axes or body.path_table is not None) \
+            else ""
+        text += "; " + (" + ".join(moves) + ramp if moves else "held still (every amplitude is 0)")
+    return text
+
+
 def force_terms(scene: Scene, model) -> list[str]:
     """Each force term the scene switches on, in a short phrase with its main parameters."""
-    rope = scene.rope
     terms = ["springs"]
-    if rope.EI:
-        terms.append(f"bending stiffness (EI = {rope.EI:g} N m^2)")
+    if any(line.EI for line in model.lines):
+        terms.append(f"bending stiffness ({_line_value(model, 'EI', 'EI', 'N m^2')})")
     if scene.bending:
         terms.append(f"bending (k2 = {scene.bending.stiffness:g} N/m)")
     if scene.gravity:
@@ -216,8 +309,8 @@ def force_terms(scene: Scene, model) -> list[str]:
         terms.append(f"thrower (v_max = {scene.thrower.v_max:g} m/s{angle})")
     if scene.guides:
         terms.append(f"{len(scene.guides)} guide circle{'s' if len(scene.guides) > 1 else ''}")
-    if rope.axial_damping:
-        terms.append(f"axial damping (BA = {rope.axial_damping:g} N s)")
+    if any(line.axial_damping for line in model.lines):
+        terms.append(f"axial damping ({_line_value(model, 'axial_damping', 'BA', 'N s')})")
     if scene.fluid:
         terms.append(f"fluid (rho = {scene.fluid.density:g} kg/m^3)")
     if scene.flow:
@@ -237,6 +330,12 @@ def force_terms(scene: Scene, model) -> list[str]:
     if scene.seabed:
         terms.append(_seabed_text(scene.seabed))
     return terms
+
+
+def _line_value(model, key: str, name: str, unit: str) -> str:
+    """``name = value unit`` when every line that has ``key`` has the same value, else ``name per line``."""
+    values = {getattr(line, key) for line in model.lines if getattr(line, key)}
+    return f"{name} = {values.pop():g} {unit}" if len(values) == 1 else f"{name} per line"
 
 
 def _seabed_text(bed) -> str:
@@ -443,22 +542,41 @@ def check_data(scene: Scene, source) -> dict:
 
     model = build(scene)
     grid = TimeGrid.of(scene)
-    rope = scene.rope
     omega_gershgorin, omega, rows = bounds(model)
-    held = []
-    if scene.pinned:
-        held += [{"kind": "pinned", "nodes": list(scene.pinned.nodes)}]
-    held += [{"kind": "driven", "nodes": list(d.nodes), "motion": _motion_text(d)} for d in scene.driven]
-    return {
-        "source": str(source), "valid": True, "scene": scene.name, "description": scene.description,
-        "dimension": scene.dimension, "nodes": rope.nodes, "closed": rope.closed,
-        "segment_length_m": rope.segment_length, "stiffness_N_per_m": rope.stiffness, "node_mass_kg": rope.mass,
-        "force_terms": force_terms(scene, model), "held": held,
+    out = {"source": str(source), "valid": True, "scene": scene.name, "description": scene.description,
+           "dimension": scene.dimension, "nodes": model.nodes}
+    if scene.is_system:
+        out.update(system_data(scene, model))
+    else:
+        rope = scene.rope
+        held = []
+        if scene.pinned:
+            held += [{"kind": "pinned", "nodes": list(scene.pinned.nodes)}]
+        held += [{"kind": "driven", "nodes": list(d.nodes), "motion": _motion_text(d)} for d in scene.driven]
+        out.update({"closed": rope.closed, "segment_length_m": rope.segment_length,
+                    "stiffness_N_per_m": rope.stiffness, "node_mass_kg": rope.mass,
+                    "force_terms": force_terms(scene, model), "held": held})
+    out.update({
         "method": scene.integrator.method, "dt_s": grid.dt, "t_end_s": scene.integrator.t_end,
         "steps": grid.steps, "frames": grid.frames,
         "omega_max_rad_per_s": omega if omega_gershgorin > 0 else None,
         "stable_dt_s": {b.method: (None if b.dt_spectral == float("inf") else b.dt_spectral) for b in rows},
-    }
+    })
+    return out
+
+
+def system_data(scene: Scene, model) -> dict:
+    """A system's make-up for ``ropesim check --json``: its lines (with their nodes), points and rigid bodies."""
+    lines = [{"id": line.id, "start": line.start, "end": line.end, "type": line.type, "length_m": line.length,
+              "segments": line.segments, "first_node": layout.first, "nodes": layout.nodes,
+              "segment_length_m": layout.segment_length, "stiffness_N_per_m": layout.stiffness,
+              "mass_per_length_kg_per_m": line.mass_per_length, "EA_N": line.EA}
+             for line, layout in zip(scene.lines, model.lines)]
+    points = [{"id": p.id, "kind": p.kind, "position_m": list(p.position), "body": p.body, "text": _point_text(p)}
+              for p in scene.points]
+    bodies = [{"id": b.id, "kind": b.kind, "position_m": list(b.position), "mass_kg": b.mass,
+               "text": _body_text(b, scene)} for b in scene.rigid_bodies]
+    return {"lines": lines, "points": points, "bodies": bodies, "force_terms": force_terms(scene, model)}
 
 
 def equilibrium_data(shape, source: str) -> dict:
@@ -505,10 +623,18 @@ def print_window(figures: dict, folder) -> None:
     def row(name, stats):
         return [name, *(f"{stats[k] / scale:.4g}" for k in ("min", "max", "mean", "std"))]
 
-    rows = [row("segment 0 (node 0's end)", figures["start"]), row("last segment", figures["end"])]
-    for h, stats in enumerate(figures.get("supports", [])):
-        rows.append(row(f"support {h}: |F|", stats))
+    if "lines" in figures:
+        rows = []
+        for line, part in figures["lines"].items():
+            rows += [row(f"{line}: start", part["start"]), row(f"{line}: end", part["end"])]
+        labels = figures.get("support_labels", [])
+    else:
+        rows = [row("segment 0 (node 0's end)", figures["start"]), row("last segment", figures["end"])]
+        labels = [f"support {h}" for h in range(len(figures.get("supports", [])))]
+    for label, stats in zip(labels, figures.get("supports", [])):
+        rows.append(row(f"{label}: |F|", stats))
     columns = ["", f"min\n[{unit}]", f"max\n[{unit}]", f"mean\n[{unit}]", f"std\n[{unit}]"]
     print_figures(console, "tension and support forces", columns, rows, keys=1)
-    console.print(f"largest tension {figures['max_N'] / scale:.4g} {unit} in segment {figures['max_segment']} at "
-                  f"t = {figures['max_t_s']:g} s")
+    for name, part in (figures["lines"] if "lines" in figures else {"": figures}).items():
+        console.print(f"largest tension{f' in {name}' if name else ''} {part['max_N'] / scale:.4g} {unit} in "
+                      f"{'its ' if name else ''}segment {part['max_segment']} at t = {part['max_t_s']:g} s")

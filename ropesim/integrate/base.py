@@ -70,7 +70,7 @@ import numpy as np
 
 from ..model.bodies import STATE_ROWS, place_attachments
 from ..model.jit import specialise
-from ..model.motion import place_moving
+from ..model.motion import Held, place_moving
 from .health import LEDGER_COLUMNS, OK, initial_ledger, limits
 
 CHECK_EVERY = 64   # steps between blow-up checks: a blow-up is caught within this many steps
@@ -87,10 +87,6 @@ BodyState = namedtuple("BodyState", ["pose", "twist"])
 """The free rigid bodies' state: pose (7, B) (reference point, orientation quaternion), twist (6, B) (velocity,
 angular velocity in world axes); see :mod:`ropesim.model.bodies`."""
 
-Held = namedtuple("Held", ["idx", "x0", "v", "motion"])
-"""The held (pinned or driven) nodes: indices (H,), positions at t = 0 (D, H) [m], velocities (D, H) [m/s]
-(constant, or for a prescribed motion the current ones, kept up to date by the loops), and their
-:class:`~ropesim.model.motion.Motion`."""
 
 Advance = namedtuple("Advance", ["done", "written", "status", "node"])
 """What a call did: steps done, frames written, health status (:mod:`ropesim.integrate.health`), its node."""
@@ -192,7 +188,8 @@ class Integrator:
             model.kernel(place_moving)(self.x, self.v, self.held, 0.0, 0.0)   # a sinusoid starts with its own velocity
         self.pose = model.body_pose0.copy()
         self.twist = model.body_twist0.copy()
-        self.bodies = BodyState(self.pose, self.twist)
+        # None without free bodies: the loops read it only behind WITH_BODIES, and compile nothing of it
+        self.bodies = BodyState(self.pose, self.twist) if self.pose.shape[1] else None
         if self.pose.shape[1]:
             place_attachments(self.x, self.v, model.params.bodies, self.pose, self.twist)
         self.ledger = initial_ledger(model, self.x, self.v, self.pose, self.twist)

@@ -249,7 +249,8 @@ def energy_scale(model) -> float:
 
 def total_mass(model) -> float:
     """Every node's mass and every free rigid body's [kg]."""
-    return float(model.mass.sum()) + float(model.params.bodies.mass.sum())
+    bodies = model.params.bodies
+    return float(model.mass.sum()) + (float(bodies.mass.sum()) if bodies is not None else 0.0)
 
 
 def stretch_limit(model) -> float:

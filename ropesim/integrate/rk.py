@@ -98,10 +98,10 @@ class RungeKuttaFamily(Integrator):
         self.tables = method.tables()
         shape = self.x.shape
         bodies = self.pose.shape[1]
+        body_scratch = ((np.zeros((7, bodies)), np.zeros((6, bodies)), np.zeros((3, bodies)),
+                         np.zeros((stages, 6, bodies)), np.zeros((stages, 6, bodies))) if bodies else (None,) * 5)
         self.scratch = RKScratch(np.zeros(shape), np.zeros(shape), np.zeros((stages,) + shape),
-                                 np.zeros((stages,) + shape), np.zeros(shape), np.zeros(shape), np.zeros((7, bodies)),
-                                 np.zeros((6, bodies)), np.zeros((3, bodies)), np.zeros((stages, 6, bodies)),
-                                 np.zeros((stages, 6, bodies)))
+                                 np.zeros((stages,) + shape), np.zeros(shape), np.zeros(shape), *body_scratch)
         self.gamma = np.where(model.held, 0.0, model.drag / model.mass)
 
     @staticmethod

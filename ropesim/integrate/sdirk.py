@@ -119,7 +119,8 @@ class SdirkFamily(Integrator):
         nt, m = dim * n, w * dim
         jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
         tol = NEWTON_TOL * min(line.segment_length for line in model.lines)
-        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, tol, np.zeros(nt), model_groups(model, w))
+        groups = model_groups(model, w) if WITH_JUNCTIONS.name in model.switches else None   # a rope's: none
+        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, tol, np.zeros(nt), groups)
         shape = (dim, n)
         self.stage = Stage(*(np.zeros(shape) for _ in Stage._fields))
         self.nodes = Nodes(np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag))

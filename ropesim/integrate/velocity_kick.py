@@ -38,8 +38,10 @@ and guides' part of it (D, N); the free bodies' slopes (4, 6, B) and sub-stage t
 
 
 def velocity_scratch(dim: int, nodes: int, bodies: int = 0) -> VelocityScratch:
+    """The scratch for ``nodes`` nodes and ``bodies`` free bodies (None in their place without any)."""
     return VelocityScratch(np.zeros((4, dim, nodes)), np.zeros((dim, nodes)), np.zeros((dim, nodes)),
-                           np.zeros((dim, nodes)), np.zeros((4, 6, bodies)), np.zeros((6, bodies)))
+                           np.zeros((dim, nodes)), np.zeros((4, 6, bodies)) if bodies else None,
+                           np.zeros((6, bodies)) if bodies else None)
 
 
 @jit.kernel

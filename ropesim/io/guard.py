@@ -33,10 +33,15 @@ HTML_MARK = '<meta name="generator" content="ropesim view">'   # ropesim.viewer.
 # A run folder's own entries (see ropesim.io.runfolder) and what commands write into it by default.
 RUN_FILES = frozenset({*RUN_MARKERS, STATE, LOCK})
 DEFAULT_OUTPUTS = frozenset({"plots.png", "frames.png", "animation.gif", "animation.mp4", "trajectory.csv", "vtk",
-                             "trajectory_tension_history.csv", "trajectory_tension_range.csv"})
+                             "trajectory_tension_history.csv", "trajectory_tension_range.csv",
+                             "trajectory_bodies.csv"})
 CSV_HEADERS = ("t [s],node,",                         # ropesim export --to csv
+               "t [s],line,node,",                    # ... of a system of lines
                "t [s],tension segment 0 [",           # ... its time history of the forces
+               "t [s],tension ",                      # ... a system's, by line
                "segment,s [m],min tension [",         # ... its tension range along the rope
+               "line,segment,s [m],min tension [",    # ... along each line of a system
+               "t [s],body,",                         # ... a system's rigid bodies
                "method,dt,steps,status,",             # ropesim accuracy: accuracy.csv
                "stiffness,method,dt,dt_over_ref",     # ropesim stability: stability.csv
                "stiffness,method,ref_dt,")            # ropesim stability: bounds.csv

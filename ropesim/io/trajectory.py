@@ -23,6 +23,7 @@ from .runfolder import SCENE, TRAJECTORY, RunFolderError
 ARRAYS = ("t", "x", "v")
 DERIVED = ("tension", "strain", "support", "body_x", "body_q", "body_v", "body_w")
 """Per frame, derived from t, x and v (and the free bodies' states) as they are stored."""
+BODY_STATE = ("body_x", "body_v", "body_q", "body_w")   # a system's rigid bodies, in the scene's order
 
 
 class FrameStore:
@@ -80,6 +81,11 @@ class FrameStore:
         return {name: a[:self.count] for name, a in self._arrays.items()}
 
 
+def scene_nodes(scene) -> int:
+    """How many nodes a scene's frames hold: a rope's, or every line's of a system."""
+    return scene.rope.nodes if scene.rope is not None else sum(line.nodes for line in scene.lines)
+
+
 @dataclass
 class Trajectory:
     """Saved frames of one run: ``t`` (F,) [s], ``x`` and ``v`` (F, N, D) [m, m/s], each segment's ``tension``
@@ -87,6 +93,12 @@ class Trajectory:
     without held nodes), the energy ledger's flows ``ledger`` (F, C) [J] (columns
     :data:`ropesim.integrate.health.LEDGER_COLUMNS`), with its scene and summary (the derived arrays and
     ``ledger`` are None for a run folder written before ropesim stored them).
+
+    A system's nodes are its lines' nodes, line after line in the scene's order; its rigid bodies' states are
+    ``body_x`` (F, B, D) [m], the reference point, ``body_v`` (F, B, D) [m/s] its velocity, ``body_q`` (F, B, 4)
+    the orientation quaternion (w, x, y, z), body frame to world frame, and ``body_w`` (F, B, 3) [rad/s] the
+    angular velocity in world axes (2-D: about z alone), every body in the scene's order (None without rigid
+    bodies). :meth:`line`, :meth:`point` and :meth:`body` give each object's results by its id.
 
     From :func:`ropesim.simulate` the arrays are in memory; from :meth:`open` they are memory-mapped.
     """
@@ -134,7 +146,7 @@ class Trajectory:
         if missing:
             raise RunFolderError(f"{folder / TRAJECTORY}: missing arrays {', '.join(missing)}")
         t, x, v = arrays["t"], arrays["x"], arrays["v"]
-        n, d = scene.rope.nodes, scene.dimension
+        n, d = scene_nodes(scene), scene.dimension
         if t.ndim != 1 or x.shape != (len(t), n, d) or v.shape != x.shape or len(t) == 0:
             raise RunFolderError(f"{folder / TRAJECTORY}: arrays do not match the scene: t {t.shape}, "
                                  f"x {x.shape}, v {v.shape}, expected (F,), (F, {n}, {d})")
@@ -143,9 +155,52 @@ class Trajectory:
             if values is not None and (values.ndim < 2 or values.shape[0] != len(t)):
                 raise RunFolderError(f"{folder / TRAJECTORY}: {name} has shape {values.shape}, not one row per "
                                      f"frame ({len(t)})")
+        bodies = len(scene.rigid_bodies)
+        for name, width in zip(BODY_STATE, (d, d, 4, 3)):
+            values = derived[name]
+            if bodies and values is not None and values.shape[1:] != (bodies, width):
+                raise RunFolderError(f"{folder / TRAJECTORY}: {name} has shape {values.shape}, expected "
+                                     f"({len(t)}, {bodies}, {width}) for the scene's {bodies} rigid bodies")
         if ledger is not None and len(ledger) != len(t):
             ledger = None
         return cls(t=t, x=x, v=v, scene=scene, summary=summary, folder=folder, ledger=ledger, **derived)
+
+    # Each object's results by its id (ropesim.analysis.objects).
+    def line(self, id: str):
+        """Line ``id``'s results (a rope is the line "rope"): its nodes' positions and velocities, each
+        segment's tension and strain, its end tensions and the force each end puts on what it is attached to
+        (:class:`ropesim.analysis.objects.LineResults`)."""
+        from ..analysis.objects import line_results
+        return line_results(self, id)
+
+    def point(self, id: str):
+        """Point ``id``'s results: its position and velocity, and the force its lines put on it
+        (:class:`ropesim.analysis.objects.PointResults`)."""
+        from ..analysis.objects import point_results
+        return point_results(self, id)
+
+    def body(self, id: str):
+        """Rigid body ``id``'s results: its position, orientation (quaternion, rotation matrix, the scene's
+        angles), velocity and angular velocity, and the force and moment its lines put on it
+        (:class:`ropesim.analysis.objects.BodyResults`)."""
+        from ..analysis.objects import body_results
+        return body_results(self, id)
+
+    @property
+    def lines(self) -> dict:
+        """Every line's results by id, in the scene's order (a rope: {"rope": ...}); see :meth:`line`."""
+        from ..analysis.objects import every_line
+        return every_line(self)
+
+    @property
+    def points(self) -> dict:
+        """Every point's results by id, in the scene's order (a rope has none); see :meth:`point`."""
+        return {p.id: self.point(p.id) for p in self.scene.points}
+
+    @property
+    def bodies(self) -> dict:
+        """Every rigid body's results by id, in the scene's order; see :meth:`body`."""
+        return {b.id: self.body(b.id) for b in self.scene.rigid_bodies}
 
     # Other tools and notebooks (ropesim.io.export, ropesim.render.notebook).
     def export(self, to: str, out: str | Path | None = None):

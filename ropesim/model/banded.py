@@ -44,7 +44,7 @@ def band_solve(band, p, r):
     substitute_up(band, p, r, 0, nt, nt)
 
 
-@jit.kernel
+@jit.kernel(inline="always")   # compiled into its callers: a rope compiles no more functions
 def band_cholesky_range(band, p, r0, r1):
     """Cholesky L L^T of rows and columns r0 .. r1 - 1 of the band matrix (``band[q, j] = A[j + q, j]``, L in
     its place), taken on their own (a system's line: :mod:`ropesim.model.schur`)."""
@@ -87,7 +87,7 @@ def band_cholesky_reverse(band, p, r0, r1):
     return True
 
 
-@jit.kernel
+@jit.kernel(inline="always")   # compiled into its callers: a rope compiles no more functions
 def substitute_down(band, p, z, r0, r1, lo):
     """z[i] <- (z[i] - sum_(k<i) band[i - k, k] z[k]) / band[0, i] for i = lo .. r1 - 1, rows r0 .. lo - 1 of z
     being zero: L^-1 z after :func:`band_cholesky_range`, U^-T z after :func:`band_cholesky_reverse`."""
@@ -98,7 +98,7 @@ def substitute_down(band, p, z, r0, r1, lo):
         z[i] = s / band[0, i]
 
 
-@jit.kernel
+@jit.kernel(inline="always")   # compiled into its callers: a rope compiles no more functions
 def substitute_up(band, p, z, r0, r1, hi):
     """z[i] <- (z[i] - sum_(k>i) band[k - i, i] z[k]) / band[0, i] for i = hi - 1 down to r0, rows hi .. r1 - 1
     of z being zero: L^-T z after :func:`band_cholesky_range`, U^-1 z after :func:`band_cholesky_reverse`."""
@@ -118,7 +118,7 @@ def band_solve_columns(band, p, z):
     substitute_columns_up(band, p, z, 0, nt, nt, 0, m)
 
 
-@jit.kernel
+@jit.kernel(inline="always")   # compiled into its callers: a rope compiles no more functions
 def substitute_columns_down(band, p, z, r0, r1, lo, c0, c1):
     """:func:`substitute_down` on columns c0 .. c1 - 1 of ``z`` (rows, columns) at once, each entry of the
     factor loaded once for all of them."""
@@ -131,7 +131,7 @@ def substitute_columns_down(band, p, z, r0, r1, lo, c0, c1):
             z[i, c] /= band[0, i]
 
 
-@jit.kernel
+@jit.kernel(inline="always")   # compiled into its callers: a rope compiles no more functions
 def substitute_columns_up(band, p, z, r0, r1, hi, c0, c1):
     """:func:`substitute_up` on columns c0 .. c1 - 1 of ``z`` (rows, columns) at once."""
     for i in range(hi - 1, r0 - 1, -1):

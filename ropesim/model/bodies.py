@@ -151,11 +151,11 @@ def bodies_bundle(scene, ends: dict[str, list[int]], added: np.ndarray) -> Bodie
                   out["added_rot"], start, node_index, arm, node_added, np.zeros((6, 7)))
 
 
-def no_bodies() -> Bodies:
-    """The empty bundle (a rope; a system without free bodies)."""
-    z3 = np.zeros((3, 0))
-    return Bodies(np.zeros(0), z3, np.zeros((3, 3, 0)), np.zeros(0), z3, z3, z3, z3, z3, np.zeros(1, dtype=np.int64),
-                  np.zeros(0, dtype=np.int64), z3, np.zeros((2, 0)), np.zeros((6, 7)))
+def no_bodies() -> None:
+    """What a scene without free bodies has in their place: None, so that the parameter bundle every compiled
+    function receives (by value, each array in it reference-counted at every call) carries nothing of bodies and
+    compiles nothing of them (its fields are read only behind :data:`WITH_BODIES`)."""
+    return None
 
 
 def body_energy_numpy(bundle: Bodies, pose: np.ndarray, twist: np.ndarray, g: float) -> dict[str, np.ndarray]:

@@ -53,9 +53,11 @@ def junction_bundle(groups: list[list[int]], added: np.ndarray) -> Junctions:
     return Junctions(start, nodes, own)
 
 
-def no_junctions() -> Junctions:
-    """The empty bundle (a rope; a system without free points joining two or more lines)."""
-    return Junctions(np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((2, 0)))
+def no_junctions() -> None:
+    """What a rope (or a system without free points joining two or more lines) has in their place: None, so the
+    parameter bundle carries and compiles nothing of them (their fields are read only behind
+    :data:`WITH_JUNCTIONS`)."""
+    return None
 
 
 @jit.kernel

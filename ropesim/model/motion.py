@@ -45,6 +45,11 @@ from . import jit
 Motion = namedtuple("Motion", ["moving", "base", "amp", "omega", "phase", "ramp", "path_t", "path_d", "span", "accel",
                                "rigid", "arm", "bodies"])
 
+Held = namedtuple("Held", ["idx", "x0", "v", "motion"])
+"""The held (pinned or driven) nodes: indices (H,), positions at t = 0 (D, H) [m], velocities (D, H) [m/s]
+(constant, or for a prescribed motion the current ones, kept up to date by the loops), and their
+:class:`Motion`: what the compiled loops and :func:`place_moving` take."""
+
 WITH_RIGID_MOTION = jit.Switch("rigid_motion", "a driven rigid body moving its points")
 
 
@@ -76,13 +81,16 @@ def motion_of(dim: int, held_idx: np.ndarray, drives, rigid=()) -> Motion:
             span[j] = (first, len(times))
     path_d = np.asarray(rows, dtype=float).T.copy() if rows else np.zeros((dim, 0))
     moving = any(drive.moving for _, drive in drives) or bool(rigid)
-    body_of, arm = np.full(h, -1, dtype=np.int64), np.zeros((3, h))
-    for b, (_, nodes) in enumerate(rigid):
-        for node, node_arm in nodes:
-            body_of[where[int(node)]] = b
-            arm[:, where[int(node)]] = node_arm
+    body_of = arm = bodies = None   # nothing of rigid motion without driven bodies (read behind WITH_RIGID_MOTION)
+    if rigid:
+        body_of, arm = np.full(h, -1, dtype=np.int64), np.zeros((3, h))
+        for b, (_, nodes) in enumerate(rigid):
+            for node, node_arm in nodes:
+                body_of[where[int(node)]] = b
+                arm[:, where[int(node)]] = node_arm
+        bodies = _body_motions(dim, [body for body, _ in rigid])
     return Motion(moving, base, amp, omega, phase, ramp, np.asarray(times, dtype=float), path_d, span,
-                  np.zeros((dim, h)), body_of, arm, _body_motions(dim, [body for body, _ in rigid]))
+                  np.zeros((dim, h)), body_of, arm, bodies)
 
 
 def _body_motions(dim: int, bodies) -> Motion:
@@ -115,7 +123,7 @@ def _body_motions(dim: int, bodies) -> Motion:
         span[b] = (first, len(times))
     path_d = np.asarray(path, dtype=float).T.copy() if path else np.zeros((6, 0))
     return Motion(bool(count), base, amp, omega, phase, ramp, np.asarray(times, dtype=float), path_d, span, pose0,
-                  np.zeros(0, dtype=np.int64), np.zeros((3, 0)), None)
+                  None, None, None)
 
 
 @jit.kernel(inline="always")

@@ -366,6 +366,8 @@ def model_groups(model, w: int) -> Groups:
     """The groups of ``model``'s Newton matrix (block half-width ``w``): its free points where lines meet
     (:class:`~ropesim.model.junctions.Junctions`); the empty bundle for a rope."""
     junctions = model.params.junctions
+    if junctions is None:
+        return no_groups(model.dim)
     members = [(model.dim, [int(i) for i in junctions.nodes[a:b]], None)
                for a, b in zip(junctions.start[:-1], junctions.start[1:])]
     if not members:

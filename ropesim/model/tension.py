@@ -16,7 +16,7 @@ import numpy as np
 from .bodies import body_frames, body_shapes
 from .forces.fluid import flow_at
 from .forces.springs import segment_forces, segment_strains
-from .motion import place_moving
+from .motion import Held, place_moving
 from .terms import accelerations
 
 
@@ -64,7 +64,7 @@ def support_forces(model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> np.nda
     out = np.zeros((len(t), idx.size, model.dim))
     forces = model.kernel(accelerations)
     if m.moving:   # the prescribed accelerations a_p, as the loops compute them
-        held = (idx, model.held_x0, model.held_v.copy(), m._replace(accel=np.zeros_like(m.accel)))
+        held = Held(idx, model.held_x0, model.held_v.copy(), m._replace(accel=np.zeros_like(m.accel)))
         prescribed = model.kernel(place_moving)
     for k in range(len(t)):
         xk, vk = np.ascontiguousarray(np.asarray(x[k]).T), np.ascontiguousarray(np.asarray(v[k]).T)

@@ -22,9 +22,10 @@ from .encode import ANIMATION_TYPES, GIF_MAX_FPS, gif_fps, write_gif, write_mp4
 from .framing import Projection, figure_inches, followed_nodes, origin, projection, single_view, view_box
 from ..io.atomic import atomic_output
 from .output import output_path
-from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
+from .scene_artist import Geometry, RopeArtist, body_state, legend_handles, style_axes
 from .style import with_picture_text
 from .timeline import animation_plan
+from .view3d import wants_3d
 
 DPI = 100
 PALETTE_SAMPLES = 5  # frames, evenly spread, whose colours make a GIF's palette
@@ -37,6 +38,7 @@ class Frames(Protocol):
     scene: Scene
     t: np.ndarray   # (F,) [s]
     x: np.ndarray   # (F, N, D) [m]
+    # and, for a system with rigid bodies, body_x (F, B, D) [m] and body_q (F, B, 4) (read with getattr)
 
 
 @dataclass(frozen=True)
@@ -57,8 +59,8 @@ class FrameRenderer:
         from matplotlib.figure import Figure
 
         self.traj, self.nodes, self.cols = traj, nodes, list(proj.axes)
-        self.layout = layout = single_view(view_box(model, traj.x, proj, nodes), size,
-                                           legend=bool(legend_handles(model)))
+        box = view_box(model, traj.x, proj, nodes, getattr(traj, "body_x", None))
+        self.layout = layout = single_view(box, size, legend=bool(legend_handles(model)))
         self.size = (layout.width, layout.height)
         fig = Figure(figsize=figure_inches(layout.width, layout.height, DPI), dpi=DPI)
         self.canvas = FigureCanvasAgg(fig)
@@ -82,18 +84,72 @@ class FrameRenderer:
             offset = -origin(x, self.nodes)[self.cols]
             self.geometry.move(offset)
         self.canvas.restore_region(self.background)
-        self.rope.show(x, offset)
+        self.rope.show(x, offset, body_state(self.traj, i))
         self.stamp.set_text(f"t = {self.traj.t[i]:.2f} s")
         for artist in self.moving:
             artist.draw(self.canvas.get_renderer())
         return np.array(self.canvas.buffer_rgba())  # a plain copy: RGBA -> RGB is left to the encoder (in C)
 
 
-def picture_title(fig, model: Model, proj: Projection) -> None:
-    """The scene's name (and the view of a 3-D scene) at the top left, the legend on a line below it."""
+class FrameRenderer3D:
+    """Renders saved frame i of a 3-D run in the 3-D view (:mod:`ropesim.render.view3d`) to an RGBA array
+    (H, W, 4) uint8, redrawing only what moves: the view is fixed, so the axes keep the projection of their one
+    full drawing (in a view that follows the driven node the fixed parts move too, and are redrawn)."""
+
+    def __init__(self, traj: Frames, model: Model, nodes: np.ndarray | None, size: int):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        from .framing import MACRO_BLOCK
+        from .view3d import Geometry3D, State3D, axes_3d, azimuth, run_box
+
+        self.traj, self.nodes = traj, nodes
+        width = MACRO_BLOCK * round(size / MACRO_BLOCK)
+        height = MACRO_BLOCK * round(0.8 * size / MACRO_BLOCK)
+        self.size = (width, height)
+        fig = Figure(figsize=figure_inches(width, height, DPI), dpi=DPI)
+        self.canvas = FigureCanvasAgg(fig)
+        top = (22 + (16 if legend_handles(model) else 0)) / height
+        box = run_box(traj.x, nodes, getattr(traj, "body_x", None))
+        self.ax = axes_3d(fig, [0.02, 0.02, 0.96, 0.96 - top], box, nodes is not None,
+                          azim=azimuth(model, np.asarray(traj.x[0])))
+        picture_title(fig, model, VIEW_3D)
+        self.geometry = Geometry3D(self.ax, model, box)
+        self.state = State3D(self.ax, model)
+        self.stamp = fig.text(1 - 6 / width, 1 - 3 / height, "", ha="right", va="top", fontsize=9)
+        fixed = self.geometry.artists if nodes is not None else [a for a in self.geometry.artists
+                                                                  if a is self.geometry.pinned]
+        # in zorder, as a full drawing would: the fixed points' markers over the lines that end on them
+        self.moving = sorted(fixed + self.state.artists, key=lambda a: a.get_zorder()) + [self.stamp]
+        for artist in self.moving:
+            artist.set_animated(True)
+        self.canvas.draw()     # the axes, their projection and the fixed parts, once
+        self.background = self.canvas.copy_from_bbox(fig.bbox)
+
+    def render(self, i: int) -> np.ndarray:
+        x = np.asarray(self.traj.x[i])
+        shift = None
+        if self.nodes is not None:
+            shift = origin(x, self.nodes)
+            self.geometry.move(shift)
+        self.state.show(x, shift, body_state(self.traj, i))
+        self.stamp.set_text(f"t = {self.traj.t[i]:.2f} s")
+        self.canvas.restore_region(self.background)
+        renderer = self.canvas.get_renderer()
+        for artist in self.moving:
+            artist.draw(renderer)
+        return np.array(self.canvas.buffer_rgba())
+
+
+VIEW_3D = None   # picture_title's projection for the 3-D view
+
+
+def picture_title(fig, model: Model, proj: Projection | None) -> None:
+    """The scene's name (and the view of a 3-D scene: a projection, or None for the 3-D view) at the top left,
+    the legend on a line below it."""
     parts = [model.scene.name]
     if model.scene.dimension == 3:
-        parts.append(f"view {''.join(proj.names)}")
+        parts.append(f"view {''.join(proj.names)}" if proj is not None else "view 3d")
     height = fig.bbox.height
     fig.text(4 / fig.bbox.width, 1 - 3 / height, "  ·  ".join(parts), ha="left", va="top", fontsize=9,
              fontweight="bold")
@@ -111,7 +167,8 @@ def animate(traj: Frames, out: str | Path, *, fps: float = 25.0, speed: float = 
     """Write an animation of ``traj`` to ``out`` (.gif or .mp4) and say what was written.
 
     fps: video frames per second; speed: simulated seconds per second of video; start/end: the time range
-    [s] (default the whole run); follow: the view from the driven node; view: the projection of a 3-D scene;
+    [s] (default the whole run); follow: the view from the driven node; view: the projection of a 3-D scene
+    ("xy", "xz", "zy", ...) or "3d" (:mod:`ropesim.render.view3d`; the default for a 3-D system);
     size: the picture's longer side [px]; note: receives one-line remarks (too few saved frames, GIF rate).
     Raises :class:`ropesim.render.RenderError` for a request that cannot be met, before writing anything.
     """
@@ -126,8 +183,12 @@ def animate(traj: Frames, out: str | Path, *, fps: float = 25.0, speed: float = 
         if fps > GIF_MAX_FPS:
             remarks.append(f"a GIF plays at most {GIF_MAX_FPS:g} fps: using {rate:g} (write an .mp4 for more)")
     plan = animation_plan(traj.t, rate, speed, start, end)
-    model = build(traj.scene)
-    proj = projection(view, traj.scene.dimension)
+    model = build(traj.scene, solve=False)   # the frames hold the shape: no static solve
+    three_d = wants_3d(view, traj.scene)
+    proj = None if three_d else projection(view, traj.scene.dimension)
+    if three_d and traj.scene.dimension != 3:
+        raise RenderError(f"--view {view}: the 3-D view is for 3-D scenes; this one is {traj.scene.dimension}-D "
+                          f"(its view is xy)")
     nodes = followed_nodes(model, follow)
     if plan.note:
         remarks.append(plan.note)
@@ -135,7 +196,8 @@ def animate(traj: Frames, out: str | Path, *, fps: float = 25.0, speed: float = 
         if note is not None:
             note(remark)
     check_memory(size * size, f"--size {size}")     # the picture is at most size x size px
-    renderer = FrameRenderer(traj, model, proj, nodes, size)
+    renderer = (FrameRenderer3D(traj, model, nodes, size) if three_d else
+                FrameRenderer(traj, model, proj, nodes, size))
     frames = _tracked((renderer.render(i) for i in plan.indices), len(plan.indices), f"encoding {out.name}",
                       progress)
     with atomic_output(real) as tmp:

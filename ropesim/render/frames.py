@@ -18,9 +18,10 @@ from ..model.build import build
 from ..io.trajectory import Trajectory
 from .framing import figure_inches, fit_box, followed_nodes, origin, projection, view_aspect, view_box
 from .output import output_path, save_png
-from .scene_artist import Geometry, RopeArtist, legend_handles, style_axes
+from .scene_artist import Geometry, RopeArtist, body_state, legend_handles, style_axes
 from .style import OUTSIDE_RIGHT, with_picture_text
 from .timeline import chosen_frames
+from .view3d import wants_3d
 
 DPI = 100
 PANEL_SIDE = 300      # [px] default longer side of one side-by-side panel's view
@@ -57,7 +58,8 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
     """Write a PNG of the frames nearest to ``times`` [s] (or ``count`` evenly spaced ones, default 6).
 
     overlay: all frames on one view, fading from the first to the last; follow: the view from the driven
-    node; view: the projection of a 3-D scene; columns: panels per row; width: the picture's width [px].
+    node; view: the projection of a 3-D scene, or "3d" (the default for a 3-D system); columns: panels per row;
+    width: the picture's width [px].
     """
     out = Path(out)
     real, _ = output_path(out, (".png",))
@@ -66,13 +68,19 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
         raise RenderError(f"--columns {columns}: must be at least 1")
     if width is not None and width < 200:
         raise RenderError(f"--width {width}: must be at least 200 px")
-    model = build(traj.scene)
-    proj = projection(view, traj.scene.dimension)
+    model = build(traj.scene, solve=False)   # the frames hold the shape: no static solve
     nodes = followed_nodes(model, follow)
-    box = view_box(model, traj.x, proj, nodes)
+    if wants_3d(view, traj.scene):
+        if traj.scene.dimension != 3:
+            raise RenderError(f"--view {view}: the 3-D view is for 3-D scenes; this one is "
+                              f"{traj.scene.dimension}-D (its view is xy)")
+        return _sheet_3d(traj, model, real, out, indices, nodes, overlay, columns, width)
+    proj = projection(view, traj.scene.dimension)
+    box = view_box(model, traj.x, proj, nodes, traj.body_x)
     aspect = view_aspect(box)
     box = fit_box(box, 1.0, aspect)
     frames = [np.asarray(traj.x[i]) for i in indices]
+    states = [body_state(traj, i) for i in indices]
     offsets = [None if nodes is None else -origin(x, nodes)[list(proj.axes)] for x in frames]
 
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -94,13 +102,13 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
         ax.set_aspect("equal", adjustable="box")
     shown = [float(traj.t[i]) for i in indices]
     if overlay:
-        _overlay(axes[0], model, proj, frames, offsets, shown)
+        _overlay(axes[0], model, proj, frames, offsets, shown, states)
     else:
-        for ax, x, offset, t in zip(axes, frames, offsets, shown):
+        for ax, x, offset, t, state in zip(axes, frames, offsets, shown, states):
             geometry = Geometry(ax, model, proj)
             if offset is not None:
                 geometry.move(offset)
-            RopeArtist(ax, model, proj).show(x, offset)
+            RopeArtist(ax, model, proj).show(x, offset, state)
             ax.set_title(f"t = {t:.2f} s", fontsize=9, pad=3)
         for ax in axes[len(frames):]:
             ax.set_visible(False)
@@ -117,7 +125,63 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
     return Sheet(path=out, times=tuple(shown), size=(px_width, px_height))
 
 
-def _overlay(ax, model, proj, frames, offsets, times) -> None:
+SIDE_3D = 380      # [px] default width of one panel of the 3-D view
+ASPECT_3D = 0.7    # its height / width
+
+
+def _sheet_3d(traj, model, real, out, indices, nodes, overlay, columns, width) -> Sheet:
+    """:func:`frame_sheet` in the 3-D view (:mod:`ropesim.render.view3d`): a 3-D axes per frame, or one for all."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from .view3d import Geometry3D, State3D, axes_3d, azimuth, run_box
+
+    box = run_box(traj.x, nodes, traj.body_x)
+    azim = azimuth(model, np.asarray(traj.x[0]))
+    cols = 1 if overlay else (columns or math.ceil(len(indices) / math.ceil(len(indices) / 3)))
+    rows = 1 if overlay else math.ceil(len(indices) / cols)
+    side = OVERLAY_SIDE if overlay else SIDE_3D
+    beside = LEGEND_ROOM if overlay else 0
+    px_width = max(width or cols * side + beside, MIN_WIDTH)
+    px_height = int(round(HEADER_ROOM + rows * ((px_width - beside) / cols * ASPECT_3D + TITLE_ROOM / 2)))
+    fig = Figure(figsize=figure_inches(px_width, px_height, DPI), dpi=DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    grid = fig.add_gridspec(rows, cols)
+    shown = [float(traj.t[i]) for i in indices]
+    frames = [(np.asarray(traj.x[i]), body_state(traj, i)) for i in indices]
+    shifts = [None if nodes is None else origin(x, nodes) for x, _ in frames]
+    if overlay:
+        from matplotlib import colormaps
+        from matplotlib.lines import Line2D
+
+        ax = axes_3d(fig, grid[0, 0], box, nodes is not None, azim=azim)
+        geometry = Geometry3D(ax, model, box)
+        if shifts[-1] is not None:
+            geometry.move(shifts[-1])
+        fades = np.linspace(*FADE, len(frames)) if len(frames) > 1 else np.array([FADE[1]])
+        handles = []
+        for (x, state), shift, t, f in zip(frames, shifts, shown, fades):
+            color = colormaps["Blues"](f)
+            State3D(ax, model, alpha=float(f), color=color).show(x, shift, state)
+            handles.append(Line2D([], [], color=color, alpha=float(f), label=f"t = {t:.2f} s"))
+        ax.legend(handles=handles, fontsize=7, **OUTSIDE_RIGHT)
+    else:
+        for k, ((x, state), shift, t) in enumerate(zip(frames, shifts, shown)):
+            ax = axes_3d(fig, grid[k // cols, k % cols], box, nodes is not None, fontsize=7, azim=azim)
+            geometry = Geometry3D(ax, model, box)
+            if shift is not None:
+                geometry.move(shift)
+            State3D(ax, model).show(x, shift, state)
+            ax.set_title(f"t = {t:.2f} s", fontsize=9, pad=0)
+    fig.suptitle(f"{model.scene.name}  ·  view 3d", x=0.01, ha="left", fontsize=10, fontweight="bold")
+    handles = legend_handles(model)
+    if handles:
+        fig.legend(handles=handles, loc="outside lower center", ncol=len(handles), frameon=False, fontsize=7)
+    save_png(fig, real, DPI)
+    return Sheet(path=out, times=tuple(shown), size=(px_width, px_height))
+
+
+def _overlay(ax, model, proj, frames, offsets, times, states) -> None:
     """All ``frames`` on ``ax``, fading from light and faint (first) to dark and solid (last)."""
     from matplotlib import colormaps
     from matplotlib.lines import Line2D
@@ -128,8 +192,8 @@ def _overlay(ax, model, proj, frames, offsets, times) -> None:
         geometry.move(offsets[-1])
     fades = np.linspace(*FADE, len(frames)) if len(frames) > 1 else np.array([FADE[1]])
     handles = []
-    for x, offset, t, f in zip(frames, offsets, times, fades):
+    for x, offset, t, f, state in zip(frames, offsets, times, fades, states):
         color = cmap(f)
-        RopeArtist(ax, model, proj, alpha=float(f), color=color).show(x, offset)
+        RopeArtist(ax, model, proj, alpha=float(f), color=color).show(x, offset, state)
         handles.append(Line2D([], [], color=color, alpha=float(f), label=f"t = {t:.2f} s"))
     ax.legend(handles=handles, fontsize=7, **OUTSIDE_RIGHT)

@@ -39,16 +39,28 @@ def projection(view: str | None, dim: int) -> Projection:
     view = "xy" if view is None else view.strip().lower()
     allowed = AXIS_NAMES[:dim]
     if len(view) != 2 or view[0] == view[1] or any(c not in allowed for c in view):
-        example = "xy (side view), xz (from above) or zy (from the front)" if dim == 3 else "xy"
+        example = "xy (side view), xz (from above) or zy (from the front), or 3d for a 3-D view" if dim == 3 else "xy"
         raise RenderError(f"--view {view}: choose two different axes of this {dim}-D scene from "
                           f"{', '.join(allowed)}, e.g. {example}")
     return Projection((allowed.index(view[0]), allowed.index(view[1])))
 
 
 def followed_nodes(model: Model, follow: bool) -> np.ndarray | None:
-    """Indices of the driven nodes whose centre the view follows, or None for the lab frame."""
+    """Indices of the driven nodes whose centre the view follows (a system's: the line ends on its driven
+    points and on its driven bodies), or None for the lab frame."""
     if not follow:
         return None
+    scene = model.scene
+    if scene.is_system:
+        from ..model.layout import point_ends
+
+        driven_bodies = {b.id for b in scene.rigid_bodies if b.kind == "driven"}
+        ends = point_ends(scene, model.lines)
+        nodes = sorted(i for p in scene.points if p.kind == "driven" or (p.kind == "body" and p.body in driven_bodies)
+                       for i in ends[p.id])
+        if not nodes:
+            raise RenderError(f"--follow: scene '{scene.name}' has no driven point or body to follow")
+        return np.asarray(nodes, dtype=np.int64)
     nodes = sorted({model.scene.node(i) for drive in model.scene.driven for i in drive.nodes})
     if not nodes:
         raise RenderError(f"--follow: scene '{model.scene.name}' has no driven node to follow "
@@ -177,12 +189,16 @@ def frame_blocks(frames: int, block: int | None = None, frame_nbytes: int = 0):
         yield slice(start, min(start + block, frames))
 
 
-def run_extent(x: np.ndarray, proj: Projection, nodes: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper corners [m] of every finite projected node position over all frames of ``x``."""
+def run_extent(x: np.ndarray, proj: Projection, nodes: np.ndarray | None,
+               bodies: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper corners [m] of every finite projected node position over all frames of ``x`` (and of the
+    rigid bodies' reference points ``bodies`` (F, B, D), if given)."""
     lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
     cols = list(proj.axes)
     for sl in frame_blocks(len(x), frame_nbytes=x[0].nbytes):
         block = np.asarray(x[sl])
+        if bodies is not None:
+            block = np.concatenate([block, np.asarray(bodies[sl])], axis=1)
         p = (block - origin(block, nodes)[:, None, :])[:, :, cols]
         p = p[np.isfinite(p).all(axis=-1)]
         if len(p):
@@ -192,15 +208,17 @@ def run_extent(x: np.ndarray, proj: Projection, nodes: np.ndarray | None) -> tup
     return lo, hi
 
 
-def view_box(model: Model, x: np.ndarray, proj: Projection, nodes: np.ndarray | None) -> np.ndarray:
-    """The view [[x0, x1], [y0, y1]] [m]: every node of the whole run (and, in the lab frame, the fixed
-    outline), padded by MARGIN and at least one segment length across."""
-    lo, hi = run_extent(x, proj, nodes)
+def view_box(model: Model, x: np.ndarray, proj: Projection, nodes: np.ndarray | None,
+             bodies: np.ndarray | None = None) -> np.ndarray:
+    """The view [[x0, x1], [y0, y1]] [m]: every node of the whole run (and the rigid bodies' reference points
+    ``bodies`` (F, B, D), and, in the lab frame, the fixed outline), padded by MARGIN and at least one segment
+    length across."""
+    lo, hi = run_extent(x, proj, nodes, bodies)
     if nodes is None:
         olo, ohi = outline_extent(outline(model, proj))
         lo, hi = np.fmin(lo, olo), np.fmax(hi, ohi)
     centre, span = (lo + hi) / 2, hi - lo
-    span = np.maximum(span, model.scene.rope.segment_length) * (1 + 2 * MARGIN)
+    span = np.maximum(span, min(line.segment_length for line in model.lines)) * (1 + 2 * MARGIN)
     return np.stack([centre - span / 2, centre + span / 2], axis=1)
 
 

@@ -4,8 +4,10 @@ same things under the same names.
 
 A mark is a set of nodes, a legend label and a kind: ``pinned`` (a black square), ``driven`` (a red triangle
 pointing down), ``heavy`` (a dark disc, the end mass or a body with mass, larger as the square root of its mass
-ratio), ``parachute`` (an orange canopy: extra drag without extra mass). No matplotlib here: it loads only with
-the pictures that draw.
+ratio), ``parachute`` (an orange canopy: extra drag without extra mass), ``point`` (a small dark disc). In a
+system the points are marked by kind: fixed points as pinned nodes, driven ones as driven nodes, a free point
+with mass as a heavy node, one without as a point (each at the first of its line ends, which move as one); the
+points on rigid bodies are drawn with their body. No matplotlib here: it loads only with the pictures that draw.
 """
 
 from __future__ import annotations
@@ -18,9 +20,11 @@ from ..model.build import Model
 
 NODE_SIZE = 2.6          # [pt] marker of an ordinary node in the pictures
 HEAVY_MIN_SCALE, HEAVY_MAX_SCALE = 1.5, 4.0   # a heavy node's marker grows as sqrt(mass ratio), within these
-KIND_COLORS = {"pinned": "black", "driven": "#d62728", "heavy": "0.15", "parachute": "#ff7f0e"}   # matplotlib's
-KIND_CSS = {"pinned": "#000000", "driven": "#d62728", "heavy": "#262626", "parachute": "#ff7f0e"}     # the same
-KIND_SIZES = {"pinned": 6.0, "driven": 8.0, "parachute": 13.0}   # [pt]; heavy: heavy_size(scale)
+KIND_COLORS = {"pinned": "black", "driven": "#d62728", "heavy": "0.15", "parachute": "#ff7f0e",   # matplotlib's
+               "point": "0.15"}
+KIND_CSS = {"pinned": "#000000", "driven": "#d62728", "heavy": "#262626", "parachute": "#ff7f0e",     # the same
+            "point": "#262626"}
+KIND_SIZES = {"pinned": 6.0, "driven": 8.0, "parachute": 13.0, "point": 5.0}   # [pt]; heavy: heavy_size(scale)
 
 
 @dataclass(frozen=True)
@@ -56,7 +60,9 @@ def heavy_scale(ratio: float) -> float:
 
 def moving_marks(model: Model) -> list[Mark]:
     """The marks that move with the rope, in drawing order: heavy nodes and parachutes (``[[overrides]]``),
-    bodies, then the driven nodes."""
+    bodies, then the driven nodes; in a system its free points, then its driven points."""
+    if model.scene.is_system:
+        return _system_marks(model)
     scene, rope = model.scene, model.scene.rope
     out = []
     base_drag = scene.drag.b if scene.drag is not None else 0.0
@@ -87,8 +93,41 @@ def moving_marks(model: Model) -> list[Mark]:
 
 
 def pinned_mark(model: Model) -> Mark | None:
-    """The pinned nodes (they stay where the scene starts them), or None."""
+    """The pinned nodes, a system's fixed points (they stay where the scene starts them), or None."""
+    if model.scene.is_system:
+        fixed = _point_nodes(model, "fixed")
+        return Mark("fixed point", fixed, "pinned") if fixed.size else None
     pinned = model.scene.pinned
     if pinned is None:
         return None
     return Mark("pinned node", np.array([model.scene.node(i) for i in pinned.nodes]), "pinned")
+
+
+def _point_nodes(model: Model, kind: str) -> np.ndarray:
+    """The first line end's node of each of a system's points of ``kind`` (points without lines left out)."""
+    from ..model.layout import point_ends
+
+    ends = point_ends(model.scene, model.lines)
+    return np.array([ends[p.id][0] for p in model.scene.points if p.kind == kind and ends[p.id]], dtype=np.int64)
+
+
+def _system_marks(model: Model) -> list[Mark]:
+    """A system's free points (a heavy disc with its mass, a small disc without), then its driven points."""
+    from ..model.layout import point_ends
+
+    scene = model.scene
+    ends = point_ends(scene, model.lines)
+    typical = float(np.median(model.mass)) if model.nodes else 1.0
+    out = []
+    for p in scene.points:
+        if p.kind != "free" or not ends[p.id]:
+            continue
+        node = np.array([ends[p.id][0]])
+        if p.mass:
+            out.append(Mark(f"{p.id} {p.mass:g} kg", node, "heavy", heavy_scale(model.mass[node[0]] / typical)))
+        else:
+            out.append(Mark(f"{p.id} (free point)", node, "point"))
+    driven = _point_nodes(model, "driven")
+    if driven.size:
+        out.append(Mark("driven point", driven, "driven"))
+    return out

@@ -53,19 +53,27 @@ def inline_animation(traj, *, fps: float = 25.0, speed: float = 1.0, start: floa
 
 
 def summary_html(traj) -> str:
-    """A short HTML table: the scene, its status, frames, time range, nodes, method and where it is stored."""
+    """A short HTML table: the scene, its status, frames, time range, nodes, method, a system's objects (the ids
+    that traj.line, traj.point and traj.body take) and where it is stored."""
+    from ..analysis.objects import line_ids, made_of
+
     scene, summary = traj.scene, traj.summary
-    rope = scene.rope
     rows = [
         ("scene", scene.name + (f": {scene.description}" if scene.description else "")),
         ("status", summary.get("status", "completed") + (f" ({summary['message']})" if summary.get("message")
                                                          else "")),
         ("frames", f"{traj.frames}, t = {float(traj.t[0]):.6g} .. {float(traj.t[-1]):.6g} s"),
-        ("nodes", f"{traj.nodes} ({'closed loop' if rope.closed else 'open line'}, {scene.dimension}-D)"),
+        ("nodes", f"{traj.nodes} ({made_of(scene)}, {scene.dimension}-D)"),
         ("method", f"{scene.integrator.method}, dt = {summary.get('dt', scene.integrator.dt):.3g} s"),
         ("arrays", f"t {tuple(traj.t.shape)} [s], x and v {tuple(traj.x.shape)} [m, m/s]"),
         ("stored", str(traj.folder) if traj.folder is not None else "in memory"),
     ]
+    if scene.is_system:   # where each object's results are
+        objects = [f"traj.line(id): {', '.join(line_ids(scene))}", f"traj.point(id): "
+                   f"{', '.join(p.id for p in scene.points)}"]
+        if scene.rigid_bodies:
+            objects.append(f"traj.body(id): {', '.join(b.id for b in scene.rigid_bodies)}")
+        rows.insert(-1, ("per object", "; ".join(objects)))
     body = "".join(f"<tr><th style='text-align:left'>{html.escape(k)}</th>"
                    f"<td style='text-align:left'>{html.escape(v)}</td></tr>" for k, v in rows)
     return f"<table><caption style='text-align:left'><b>ropesim.Trajectory</b></caption>{body}</table>"

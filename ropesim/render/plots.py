@@ -1,8 +1,12 @@
 """`ropesim plot`: the figures a user wants from a run, one panel each, stacked in one PNG.
 
-Every run: the mechanical energy term by term [J], and the largest relative spring stretch |r| / l - 1 [%],
-over time. A towed rope (the helicopter scenes): the angle from vertical of every segment along the rope at
-the last frame, against the exact discrete steady state. A string shooter: the loop's inclination over time.
+Every run: the mechanical energy term by term [J], the energy ledger, and the largest relative spring stretch
+|r| / l - 1 [%], over time; the tension at the rope's ends over time, and along the rope. A system of lines:
+its shape at the last frame (every line drawn and labelled, over its start), the tension at every line end over
+time and along each line, and its rigid bodies' motions (their reference points from where they start, and
+their angles) over time. A towed rope (the helicopter scenes): the angle from vertical of every segment along
+the rope at the last frame, against the exact discrete steady state. A string shooter: the loop's inclination
+over time.
 Per-frame series are computed in blocks of frames, so a memory-mapped run of any length can be plotted.
 ``start``/``stop`` (``--from``/``--to``) plot a window of the run, its ranges and extremes over that window;
 forces are in kN where they reach kilonewtons.
@@ -17,13 +21,15 @@ from typing import Callable
 import numpy as np
 
 from ..analysis.summary import block_frames
+from ..model.bodies import free_body_state
 from ..model.energy import energy_terms
 from ..analysis.towed import exact_steady_state, segment_angles, shape_verdict, towed_end
 from ..model.build import Model, build
-from ..model.forces.springs import pair_spring_stretch
+from ..model.forces.springs import segment_strains
 from ..io.trajectory import Trajectory
 from .framing import figure_inches, frame_blocks
 from .output import output_path, save_png
+from .scene_artist import legend_handles, line_color
 from .style import OUTSIDE_RIGHT, with_picture_text
 
 DPI = 100
@@ -32,19 +38,19 @@ PANEL_HEIGHT = 250   # [px] per panel
 HEADER = 40          # [px] the title
 
 
-def per_frame(traj: Trajectory, fn: Callable[[np.ndarray, np.ndarray], np.ndarray | dict]):
-    """``fn(x, v)`` over blocks of frames ((B, N, D) each), joined along the frame axis (arrays or dicts)."""
+def per_frame(traj: Trajectory, fn: Callable[..., np.ndarray | dict], with_frames: bool = False):
+    """``fn(x, v)`` over blocks of frames ((B, N, D) each), joined along the frame axis (arrays or dicts); with
+    ``with_frames``, ``fn(x, v, block)``, ``block`` the block's slice of the frames."""
     blocks = frame_blocks(traj.frames, frame_nbytes=traj.x[0].nbytes)
-    parts = [fn(np.asarray(traj.x[sl]), np.asarray(traj.v[sl])) for sl in blocks]
+    parts = [fn(np.asarray(traj.x[sl]), np.asarray(traj.v[sl]), *((sl,) if with_frames else ())) for sl in blocks]
     if isinstance(parts[0], dict):
         return {key: np.concatenate([p[key] for p in parts]) for key in parts[0]}
     return np.concatenate(parts)
 
 
 def largest_stretch_series(traj: Trajectory, model: Model) -> np.ndarray:
-    """The largest relative stretch |r| / l - 1 of the rope's springs in each frame."""
-    rope = model.scene.rope
-    return per_frame(traj, lambda x, v: pair_spring_stretch(x, rope.segment_length, 1, rope.closed).max(axis=1))
+    """The largest relative stretch |r| / l - 1 of the springs of every line in each frame."""
+    return per_frame(traj, lambda x, v: segment_strains(model, x).max(axis=1))
 
 
 def last_finite_frame(traj: Trajectory) -> int:
@@ -59,7 +65,8 @@ def last_finite_frame(traj: Trajectory) -> int:
 
 
 def draw_energy(ax, traj: Trajectory, model: Model) -> None:
-    terms = per_frame(traj, lambda x, v: energy_terms(model, x, v))
+    terms = per_frame(traj, lambda x, v, block: energy_terms(model, x, v, *free_body_state(model, traj, block)),
+                      with_frames=True)
     for name, values in terms.items():
         if name == "total":
             ax.plot(traj.t, values, color="black", linewidth=1.8, label="total")
@@ -85,7 +92,7 @@ def draw_ledger(ax, traj: Trajectory, model: Model) -> None:
     if traj.ledger is not None:   # the frames' own flows (a window of the run has only its own)
         flows = traj.ledger
     n = min(len(flows), traj.frames)
-    series = ledger_series(model, traj.x, traj.v, flows[:n], energy0)
+    series = ledger_series(model, traj.x, traj.v, flows[:n], energy0, traj)
     t = traj.t[:n]
     ax.plot(t, series["total"] - energy0, color="black", linewidth=1.6, label="E(t) - E(0)")
     ax.plot(t, series["held_work"], linewidth=1.1, label="work by held nodes")
@@ -150,40 +157,142 @@ def draw_inclination(ax, traj: Trajectory, model: Model) -> None:
 
 
 def draw_end_tensions(ax, traj: Trajectory, model: Model) -> None:
-    """The tension in the rope's first and last segments over time."""
-    from ..analysis.tension import force_unit
+    """The tension in the first and last segment of every line (a rope's two ends) over time."""
+    from ..analysis.tension import end_columns, force_unit
 
-    ends = np.asarray(traj.tension[:, [0, -1]])
+    labels = end_columns(model)
+    ends = np.asarray(traj.tension[:, [column for _, column in labels]])
     unit, scale = force_unit(float(np.nanmax(np.abs(ends), initial=0.0)))
-    ax.plot(traj.t, ends[:, 0] / scale, linewidth=1.1, label="segment 0 (at node 0)")
-    if traj.tension.shape[1] > 1:
-        ax.plot(traj.t, ends[:, 1] / scale, linewidth=1.1, label=f"segment {traj.tension.shape[1] - 1} (the other end)")
+    system = model.scene.is_system
+    for k, (label, _) in enumerate(labels):
+        style = {"color": line_color(k // 2), "linestyle": "-" if k % 2 == 0 else "--"} if system else {}
+        ax.plot(traj.t, ends[:, k] / scale, linewidth=1.1, label=label, **style)
     ax.axhline(0, color="0.6", linewidth=0.8)
     ax.set_ylabel(f"tension [{unit}]")
-    ax.set_title("Tension at the rope's ends")
+    ax.set_title("Tension at every line end" if system else "Tension at the rope's ends")
     ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
 
 def draw_tension_profile(ax, traj: Trajectory, model: Model) -> None:
-    """Tension along the rope at the last frame, and its range over the run."""
+    """Tension along each line (a rope) at the last frame, and its range over the run."""
+    from ..analysis.tension import force_unit
+    from ..model.tension import line_segments
+
     tension = traj.tension
     i = last_finite_frame(traj)
-    along = (np.arange(tension.shape[1]) + 0.5) * model.scene.rope.segment_length
     low, high = np.full(tension.shape[1], np.inf), np.full(tension.shape[1], -np.inf)
     step = block_frames(tension[0].nbytes)
     for s in range(0, len(traj.t), step):
         block = np.asarray(tension[s:s + step])
         low, high = np.minimum(low, np.nanmin(block, axis=0)), np.maximum(high, np.nanmax(block, axis=0))
-    from ..analysis.tension import force_unit
-
     unit, scale = force_unit(float(np.nanmax(np.abs(high), initial=0.0)))
     span = f"t = {traj.t[0]:.3g} .. {traj.t[-1]:.3g} s"
-    ax.fill_between(along, low / scale, high / scale, color="#1f77b4", alpha=0.2, linewidth=0, label=f"range, {span}")
-    ax.plot(along, np.asarray(tension[i]) / scale, "o-", markersize=3, color="#1f77b4", label=f"t = {traj.t[i]:.3g} s")
+    system = model.scene.is_system
+    for k, (line, part) in enumerate(zip(model.lines, line_segments(model))):
+        along = (np.arange(line.segments) + 0.5) * line.segment_length
+        color = line_color(k) if system else "#1f77b4"
+        ax.fill_between(along, low[part] / scale, high[part] / scale, color=color, alpha=0.2, linewidth=0,
+                        label=f"range, {span}" if k == 0 else None)
+        ax.plot(along, np.asarray(tension[i, part]) / scale, "o-", markersize=3, color=color,
+                label=f"{line.id}, t = {traj.t[i]:.3g} s" if system else f"t = {traj.t[i]:.3g} s")
     ax.axhline(0, color="0.6", linewidth=0.8)
-    ax.set_xlabel("distance along the rope from node 0 (at rest) [m]")
+    ax.set_xlabel("distance along each line from its start (at rest) [m]" if system
+                  else "distance along the rope from node 0 (at rest) [m]")
     ax.set_ylabel(f"tension [{unit}]")
-    ax.set_title("Tension along the rope")
+    ax.set_title("Tension along each line (shaded: its range)" if system else "Tension along the rope")
+    ax.legend(fontsize=7, **OUTSIDE_RIGHT)
+
+
+def draw_shape(ax, traj: Trajectory, model: Model) -> None:
+    """A system's shape at the last frame, every line in its colour and labelled at its middle, the points and
+    bodies marked; its start in light grey below (a 3-D scene seen from the side, x across and y up)."""
+    from .framing import projection, view_box
+    from .scene_artist import Geometry, RopeArtist, body_state
+
+    i = last_finite_frame(traj)
+    if ax.name == "3d":
+        _draw_shape_3d(ax, traj, model, i)
+        return
+    proj = projection(None, model.dim)
+    Geometry(ax, model, proj)
+    RopeArtist(ax, model, proj, color="0.82").show(np.asarray(traj.x[0]), None, body_state(traj, 0))
+    shown = RopeArtist(ax, model, proj)
+    x = np.asarray(traj.x[i])
+    shown.show(x, None, body_state(traj, i))
+    for line in model.lines:
+        middle = x[line.first + line.nodes // 2, list(proj.axes)]
+        ax.annotate(line.id, middle, xytext=(4, 4), textcoords="offset points", fontsize=7, zorder=7,
+                    bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "edgecolor": "none", "alpha": 0.8})
+    box = view_box(model, traj.x, proj, None, traj.body_x)
+    ax.set_xlim(*box[0])
+    ax.set_ylim(*box[1])
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel(f"{proj.names[0]} [m]")
+    ax.set_ylabel(f"{proj.names[1]} [m]")
+    ax.legend(handles=legend_handles(model), fontsize=7, **OUTSIDE_RIGHT)
+    ax.set_title(f"Shape at t = {traj.t[i]:.3g} s (grey: t = {traj.t[0]:.3g} s)"
+                 + (", seen from the side" if model.dim == 3 else ""))
+
+
+def _draw_shape_3d(ax, traj: Trajectory, model: Model, i: int) -> None:
+    """:func:`draw_shape` in the 3-D view (:func:`shape_axes` made ``ax``)."""
+    from .scene_artist import body_state
+    from .view3d import Geometry3D, State3D, plotted
+
+    Geometry3D(ax, model, ax.scene_box)
+    State3D(ax, model, color="0.82").show(np.asarray(traj.x[0]), None, body_state(traj, 0))
+    x = np.asarray(traj.x[i])
+    State3D(ax, model).show(x, None, body_state(traj, i))
+    for line in model.lines:
+        ax.text(*plotted(x[line.first + line.nodes // 2]), f" {line.id}", fontsize=7, zorder=7)
+    ax.legend(handles=legend_handles(model), fontsize=7, **OUTSIDE_RIGHT)
+    ax.set_title(f"Shape at t = {traj.t[i]:.3g} s (grey: t = {traj.t[0]:.3g} s)")
+
+
+def shape_axes(fig, spec, traj: Trajectory, model: Model):
+    """The shape panel's axes: a 3-D view for a 3-D scene (:mod:`ropesim.render.view3d`), else a plain one."""
+    if model.dim != 3:
+        return fig.add_subplot(spec)
+    from .view3d import axes_3d, azimuth, run_box
+
+    box = run_box(traj.x, None, traj.body_x)
+    ax = axes_3d(fig, spec, box, False, azim=azimuth(model, np.asarray(traj.x[0])))
+    ax.scene_box = box
+    return ax
+
+
+BODY_STYLES = ("-", "--", ":", "-.")   # a system's rigid bodies, in turn
+
+
+def draw_body_motion(ax, traj: Trajectory, model: Model) -> None:
+    """Each rigid body's reference point over time, from where it starts (x red, y green, z blue)."""
+    from .scene_artist import AXIS_COLORS
+
+    for b, body in enumerate(model.scene.rigid_bodies):
+        position = np.asarray(traj.body(body.id).position)
+        for k in range(model.dim):
+            ax.plot(traj.t, position[:, k] - position[0, k], color=AXIS_COLORS[k], linewidth=1.1,
+                    linestyle=BODY_STYLES[b % len(BODY_STYLES)], label=f"{body.id}: Δ{'xyz'[k]}")
+    ax.axhline(0, color="0.6", linewidth=0.8)
+    ax.set_ylabel("displacement [m]")
+    ax.set_title("Rigid bodies: their reference points from where they start")
+    ax.legend(fontsize=7, **OUTSIDE_RIGHT)
+
+
+def draw_body_rotation(ax, traj: Trajectory, model: Model) -> None:
+    """Each rigid body's orientation over time, as the scene's angles (about x, then y, then z)."""
+    from .scene_artist import AXIS_COLORS
+
+    axes = "xyz" if model.dim == 3 else "z"
+    for b, body in enumerate(model.scene.rigid_bodies):
+        angles = traj.body(body.id).angles
+        for k, name in enumerate(axes):
+            ax.plot(traj.t, angles[:, k], color=AXIS_COLORS["xyz".index(name)], linewidth=1.1,
+                    linestyle=BODY_STYLES[b % len(BODY_STYLES)], label=f"{body.id}: about {name}")
+    ax.axhline(0, color="0.6", linewidth=0.8)
+    ax.set_ylabel("angle [deg]")
+    ax.set_title("Rigid bodies: orientation, as the scene's angles (about x, then y, then z)"
+                 if model.dim == 3 else "Rigid bodies: orientation, the angle about z")
     ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
 
@@ -196,16 +305,23 @@ class Panel:
     draw: Callable  # (ax, traj, model) -> None
     time_axis: bool = True
     needs_tension: bool = False   # only for run folders that store tension (ropesim 0.2 on)
+    needs_bodies: bool = False    # only for runs that store rigid bodies' states
+    axes: Callable | None = None  # (fig, subplot spec, traj, model) -> its axes; None: a plain one
+    rows: Callable[[Model], int] = lambda model: 1   # its height, in panels
 
 
 PANELS = (
+    Panel("shape", lambda model: model.scene.is_system, draw_shape, time_axis=False, axes=shape_axes,
+          rows=lambda model: 2 if model.dim == 3 else 1),
     Panel("energy", lambda model: True, draw_energy),
     Panel("ledger", lambda model: True, draw_ledger),
     Panel("stretch", lambda model: True, draw_stretch),
     Panel("end tensions", lambda model: True, draw_end_tensions, needs_tension=True),
     Panel("tension profile", lambda model: True, draw_tension_profile, time_axis=False, needs_tension=True),
+    Panel("body motion", lambda model: bool(model.scene.rigid_bodies), draw_body_motion, needs_bodies=True),
+    Panel("body rotation", lambda model: bool(model.scene.rigid_bodies), draw_body_rotation, needs_bodies=True),
     Panel("towed", lambda model: towed_end(model.scene) is not None, draw_towed, time_axis=False),
-    Panel("shooter", lambda model: model.scene.thrower is not None and model.scene.rope.closed, draw_inclination),
+    Panel("shooter", lambda model: model.scene.thrower is not None and model.lines[0].closed, draw_inclination),
 )
 
 
@@ -227,7 +343,8 @@ def windowed(traj: Trajectory, start: float | None, stop: float | None) -> Traje
     if start is None and stop is None:
         return traj
     sl = frame_window(traj.t, start, stop)
-    cut = {name: getattr(traj, name)[sl] for name in ("t", "x", "v", "tension", "strain", "support", "ledger")
+    cut = {name: getattr(traj, name)[sl] for name in ("t", "x", "v", "tension", "strain", "support", "ledger",
+                                                      "body_x", "body_v", "body_q", "body_w")
            if getattr(traj, name) is not None}
     return replace(traj, **cut)
 
@@ -242,12 +359,15 @@ def run_figure(traj: Trajectory, start: float | None = None, stop: float | None 
         traj = windowed(traj, start, stop)
     except ValueError as exc:
         raise RenderError(str(exc)) from None
-    model = build(traj.scene)
-    panels = [p for p in PANELS if p.applies(model) and (traj.tension is not None or not p.needs_tension)]
-    height = HEADER + PANEL_HEIGHT * len(panels)
+    model = build(traj.scene, solve=False)   # the frames hold the shape: no static solve
+    panels = [p for p in PANELS if p.applies(model) and (traj.tension is not None or not p.needs_tension)
+              and (traj.body_x is not None or not p.needs_bodies)]
+    rows = [panel.rows(model) for panel in panels]
+    height = HEADER + PANEL_HEIGHT * sum(rows)
     fig = Figure(figsize=figure_inches(WIDTH, height, DPI), dpi=DPI, layout="constrained")
-    axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
-    for ax, panel in zip(axes, panels):
+    grid = fig.add_gridspec(len(panels), 1, height_ratios=rows)
+    for k, panel in enumerate(panels):
+        ax = (panel.axes or (lambda fig, spec, traj, model: fig.add_subplot(spec)))(fig, grid[k, 0], traj, model)
         panel.draw(ax, traj, model)
         if panel.time_axis:
             ax.set_xlabel("t [s]")

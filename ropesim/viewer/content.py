@@ -16,8 +16,11 @@ A :class:`RunContent` holds, for one run, its saved times and
 Positions are in metres, in the scene's axes (y up); a 2-D run's are (x, y). Every per-frame array has the run's
 frames on its first axis and may be a memory map: nothing is read here, so the packer can thin the frames first.
 
-Today a run folder holds one line; :func:`run_content` is the one function that reads a run folder into this
-structure, so a scene with several lines, rigid bodies or a sea surface only fills more entries of it.
+:func:`run_content` is the one function that reads a run folder into this structure: one rope is one line; a
+system of lines fills a line per line (each coloured by its own tension, strain or speed), its points as glyphs
+(fixed, driven, free, and the points on its bodies), and its rigid bodies as boxes: the scene gives a body no
+shape, so it is drawn as the box around its reference point and the points on it, in its own axes (each side at
+least a tenth of its longest), turning with it; a sea surface would fill more entries of it.
 """
 
 from __future__ import annotations
@@ -205,8 +208,13 @@ def run_content(run) -> RunContent:
     content = RunContent(name=scene.name, dimension=scene.dimension, t=np.asarray(traj.t, dtype=float),
                          description=scene.description,
                          where=str(traj.folder) if traj.folder is not None else "in memory")
-    content.lines.append(Line("rope", traj.x, closed=scene.rope.closed, fields=tuple(fields)))
-    content.points.extend(_marks(model))
+    if scene.is_system:
+        content.lines.extend(_system_lines(traj, model))
+        content.points.extend(_system_points(traj, model))
+        content.bodies.extend(_rigid_bodies(traj))
+    else:
+        content.lines.append(Line("rope", traj.x, closed=scene.rope.closed, fields=tuple(fields)))
+        content.points.extend(_marks(model))
     content.bodies.extend(_thrower(scene))
     content.shapes.extend(Shape("guide circle", "cylinder", _padded(g.center), g.radius, dashed=g.one_sided)
                           for g in scene.guides)
@@ -215,6 +223,91 @@ def run_content(run) -> RunContent:
     content.series.extend(_series(traj, model))
     content.summary.extend(_summary(traj, content))
     return content
+
+
+def _system_lines(traj, model) -> list[Line]:
+    """Each line of a system, its positions and fields views of the run's (nothing read here)."""
+    out, first_segment = [], 0
+    for line in model.lines:
+        nodes, segments = slice(line.first, line.end), slice(first_segment, first_segment + line.segments)
+        first_segment += line.segments
+        fields = []
+        if traj.tension is not None:
+            fields.append(Field("tension", "N", "segment", traj.tension[:, segments]))
+        if traj.strain is not None:
+            fields.append(Field("strain", "%", "segment", Scaled(traj.strain[:, segments], 100.0)))
+        fields.append(Field("speed", "m/s", "node", Speed(traj.v[:, nodes])))
+        out.append(Line(line.id, traj.x[:, nodes], closed=line.closed, fields=tuple(fields)))
+    return out
+
+
+class NodeSubset:
+    """The positions (F, K, D) of nodes ``nodes`` of a run's (F, N, D), read when indexed by frames."""
+
+    def __init__(self, x: FrameArray, nodes):
+        self.x, self.nodes = x, list(nodes)
+        self.shape = (x.shape[0], len(self.nodes), x.shape[2])
+        self.ndim = 3
+
+    def __getitem__(self, index):
+        return np.asarray(self.x[index])[..., self.nodes, :]
+
+
+def _system_points(traj, model) -> list[Points]:
+    """A system's marks (fixed, free and driven points, as `ropesim animate` marks them), then the points on its
+    rigid bodies, each a glyph at its own positions (the first of its line ends)."""
+    from ..model.layout import point_ends
+    from ..render.marks import moving_marks, pinned_mark
+
+    out = [Points(m.label, m.kind, m.css_color, _screen_size(m.size), positions=NodeSubset(traj.x, m.nodes))
+           for m in (pinned_mark(model), *moving_marks(model)) if m is not None]
+    ends = point_ends(model.scene, model.lines)
+    on_bodies = [ends[p.id][0] for p in model.scene.points if p.kind == "body"]
+    if on_bodies:
+        out.append(Points("point on a body", "point", BODY_POINT_CSS, _screen_size(5.0),
+                          positions=NodeSubset(traj.x, on_bodies)))
+    return out
+
+
+BODY_POINT_CSS = "#4d4d4d"
+BODY_CSS = "#a6bddb"
+MIN_SIDE = 0.1     # a body's box: no side shorter than this fraction of its longest
+
+
+class BoxCentre:
+    """The centre (F, D) [m] of body ``b``'s box, ``offset`` (D,) [m] from its reference point in its own
+    axes: x_b + R(q) offset, read when indexed by frames."""
+
+    def __init__(self, traj, b: int, offset: np.ndarray):
+        self.traj, self.b, self.offset = traj, b, np.asarray(offset, dtype=float)
+        self.shape = (len(traj.t), traj.body_x.shape[2])
+        self.ndim = 2
+
+    def __getitem__(self, index):
+        from ..analysis.rotation import rotation_matrix
+
+        dim = self.shape[1]
+        x = np.asarray(self.traj.body_x[index], dtype=float)[..., self.b, :]
+        turn = rotation_matrix(np.asarray(self.traj.body_q[index])[..., self.b, :], dim)
+        return x + turn @ self.offset
+
+
+def _rigid_bodies(traj) -> list[Body]:
+    """A system's rigid bodies as boxes around their reference points and their points (see the module)."""
+    if traj.body_x is None:
+        return []
+    scene = traj.scene
+    dim = scene.dimension
+    out = []
+    for b, body in enumerate(scene.rigid_bodies):
+        local = np.array([np.zeros(dim)] + [p.position for p in scene.points if p.kind == "body"
+                                            and p.body == body.id], dtype=float)
+        lo, hi = local.min(axis=0), local.max(axis=0)
+        side = np.maximum(hi - lo, MIN_SIDE * float(np.max(hi - lo)) or 1.0)
+        size = tuple(float(v) for v in side) + ((0.0,) if dim == 2 else ())
+        out.append(Body(body.id, size, BoxCentre(traj, b, (lo + hi) / 2), traj.body_q[:, b],
+                        fixed=body.kind == "fixed", color=BODY_CSS))
+    return out
 
 
 def _padded(v) -> tuple[float, float, float]:
@@ -255,13 +348,18 @@ def _thrower(scene) -> list[Body]:
 def _series(traj, model) -> list[Series]:
     """The panel's series: an open line's end tensions, or a string shooter's loop inclination."""
     scene = model.scene
-    if scene.thrower is not None and scene.rope.closed:
+    if scene.thrower is not None and model.lines[0].closed:
         from ..analysis.shooter import loop_inclination
 
         return [Series("loop inclination", "deg", _blockwise(traj.x, lambda x: loop_inclination(model, x)))]
     if traj.tension is None:
         return []
     tension = traj.tension
+    if scene.is_system:
+        from ..analysis.tension import end_columns
+
+        return [Series(f"tension at {label}", "N", np.asarray(tension[:, column], dtype=float))
+                for label, column in end_columns(model)]
     if scene.rope.closed:
         return [Series("largest tension", "N", _blockwise(tension, lambda block: np.nanmax(block, axis=1)))]
     last = tension.shape[1] - 1
@@ -283,14 +381,14 @@ def _blockwise(frames: FrameArray, fn) -> np.ndarray:
 
 def _summary(traj, content: RunContent) -> list[tuple[str, str]]:
     """The rows of the summary table: what the run is, then `ropesim run`'s own summary rows."""
+    from ..analysis.objects import made_of
     from ..cli.report import summary_rows
 
     scene, summary = traj.scene, traj.summary
     status = summary.get("status", "completed")
     rows = [("scene", scene.name + (f": {scene.description}" if scene.description else "")),
             ("status", status),
-            ("nodes", f"{traj.nodes} ({'closed loop' if scene.rope.closed else 'open line'}, "
-                      f"{scene.dimension}-D)"),
+            ("nodes", f"{traj.nodes} ({made_of(scene)}, {scene.dimension}-D)"),
             ("frames", f"{traj.frames}, t = {float(traj.t[0]):.6g} .. {float(traj.t[-1]):.6g} s")]
     rows += [row for row in summary_rows(summary) if row[0] != "simulated" or status != "incomplete"]
     rows.append(("stored", content.where))

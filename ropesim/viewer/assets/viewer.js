@@ -132,7 +132,9 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
       if (a >= 1e6) { v = value / 1e6; u = "MN"; } else if (a >= 1e4) { v = value / 1e3; u = "kN"; }
     }
     const a = Math.abs(v);
-    const text = a !== 0 && (a < 1e-3 || a >= 1e5) ? v.toExponential(2) : v.toPrecision(4).replace(/\.?0+$/, "");
+    // trailing zeros go only after a decimal point: 7440 stays 7440, 2.500 is 2.5
+    const text = a !== 0 && (a < 1e-3 || a >= 1e5) ? v.toExponential(2)
+      : v.toPrecision(4).replace(/(\.\d*?)0+$/, "$1").replace(/\.$/, "");
     return u ? `${text} ${u}` : text;
   }
 
