@@ -1,6 +1,7 @@
 """ropesim against MoorDyn on MoorDyn's own system cases: OC3-Hywind's three chains on a surging vessel
 (``lines.txt``), a free rigid body turned by a line (``body_tests/rotatingBody.txt``) and a mass dropped onto its
-slack line (``lifting.txt``). Prints the agreement as Markdown tables and draws docs/images/moordyn_systems.png.
+slack line (``lifting.txt``); and a free body in water, the speed benchmark's spar on lines.txt's chains
+(``spar_free.txt``, ours). Prints the agreement as Markdown tables and draws docs/images/moordyn_systems.png.
 
 tests/references/moordyn_systems.py builds each case for ropesim from MoorDyn's own input file and sets out the
 conventions (the frame, MoorDyn's Euler angles, the coupled points' velocity jumps, what MoorDyn's body leaves
@@ -15,8 +16,9 @@ out). Compared:
   halved, and for lifting MoorDyn against itself started 1 nm off (the snapping line is chaotic).
 
     pip install -e ".[test]"     # moordyn, scipy
-    python scripts/compare_moordyn_systems.py [--cases lines,rotatingBody,lifting] [--figure PATH]
+    python scripts/compare_moordyn_systems.py [--cases lines,rotatingBody,lifting,spar] [--figure PATH]
     python scripts/compare_moordyn_systems.py --regenerate      # rerun MoorDyn for tests/data/moordyn/own_systems.*
+                                                  # (--cases: only those cases' runs; the others' are kept)
 
 About 3 minutes on a shared 2-core machine (most of it compiling); --regenerate adds about a minute.
 """
@@ -38,6 +40,7 @@ from references.moordyn_systems import (
     EULER_CHECK,
     LIFTING_RUN,
     LINES_SURGE,
+    SPAR_RUN,
     STORED,
     SYSTEMS,
     body_rotations_moordyn,
@@ -47,6 +50,7 @@ from references.moordyn_systems import (
     gyroscopic_share,
     lifting_closed_form,
     load_stored,
+    moordyn_centripetal_excess,
     moordyn_euler_check,
     moordyn_ic,
     read_system,
@@ -55,6 +59,8 @@ from references.moordyn_systems import (
     rotation_angle_between,
     run_moordyn_system,
     run_system,
+    run_system_from,
+    spar_changes,
     start_positions,
     static_positions,
     static_tensions,
@@ -78,15 +84,29 @@ def pct(x: float) -> str:
 # ------------------------------------------------------------------------------------------------ MoorDyn data
 
 
-def regenerate() -> None:
-    """Run MoorDyn for every stored array: the IC states of lines.txt and lifting.txt, and each case's dynamic run
-    with the file's scheme and step and with RK4 at half the step, from the start ropesim's scene gives."""
+def regenerate(names) -> None:
+    """Run MoorDyn for the stored arrays of the cases ``names`` (the others' are kept): the IC states of lines.txt
+    and lifting.txt, and each case's dynamic run with the file's scheme and step and with RK4 at half the step,
+    from the start ropesim's scene gives."""
     from references.moordyn_harness import moordyn_version
 
-    record: dict = {"moordyn_version": moordyn_version(), "made_by": "scripts/compare_moordyn_systems.py --regenerate",
-                    "tight_ic_options": TIGHT_IC, "cases": {},
-                    "euler_check": {**EULER_CHECK, "moordyn_position_m": moordyn_euler_check()}}
-    arrays: dict[str, np.ndarray] = {}
+    arrays, record = load_stored() if Path(f"{STORED}.json").exists() else ({}, {"cases": {}})
+    for name in names:
+        for key in [k for k in arrays if k.startswith(name + "_")]:
+            del arrays[key]
+    record |= {"moordyn_version": moordyn_version(), "made_by": "scripts/compare_moordyn_systems.py --regenerate",
+               "tight_ic_options": TIGHT_IC, "euler_check": {**EULER_CHECK,
+                                                             "moordyn_position_m": moordyn_euler_check()}}
+    for name in names:
+        print(f"  {name} ...", flush=True)
+        record["cases"][name] = REGENERATE[name](arrays)
+    record["fields"] = FIELDS
+    np.savez_compressed(f"{STORED}.npz", **arrays)
+    Path(f"{STORED}.json").write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
+    print(f"wrote {STORED}.npz, {STORED}.json")
+
+
+def regenerate_lines(arrays: dict) -> dict:
     s = read_system("lines")
     # lines: its IC as filed, without its saved .ic state, and tight; then the surge from ropesim's static state
     print("  lines: MoorDyn's IC (as filed, by dynamic relaxation, without its .ic, tight) ...", flush=True)
@@ -102,21 +122,24 @@ def regenerate() -> None:
     for k, ic in ics.items():
         arrays[f"lines_ic_{k}_positions"] = ic["positions"]
     _store_run(arrays, "lines", rk2, rk4, every_positions=POSITIONS_EVERY["lines"])
-    record["cases"]["lines"] = {
-        "ic": {k: {"fairlead_tension_N": ic["fairlead"].tolist(), "anchor_tension_N": ic["anchor"].tolist(),
-                   "init_wall_s": ic["init_wall"]} for k, ic in ics.items()},
-        "dynamic": _run_record(rk2, rk4, drive), "surge": LINES_SURGE}
-    # rotatingBody: MoorDyn's own drive from the file's layout
-    print("  rotatingBody: the three quarter turns ...", flush=True)
+    return {"ic": {k: {"fairlead_tension_N": ic["fairlead"].tolist(), "anchor_tension_N": ic["anchor"].tolist(),
+                       "init_wall_s": ic["init_wall"]} for k, ic in ics.items()},
+            "dynamic": _run_record(rk2, rk4, drive), "surge": LINES_SURGE}
+
+
+def regenerate_rotating(arrays: dict) -> dict:
+    """rotatingBody: MoorDyn's own drive from the file's layout."""
     s = read_system("rotatingBody")
     drive = drive_of("rotatingBody")
     rk2 = run_moordyn_system("rotatingBody", drive, drive.t_end, drive.dt_out)
     rk4 = run_moordyn_system("rotatingBody", drive, drive.t_end, drive.dt_out,
                              options={"tScheme": "RK4", "dtM": s.file.dtM / 2})
     _store_run(arrays, "rotatingBody", rk2, rk4)
-    record["cases"]["rotatingBody"] = {"dynamic": _run_record(rk2, rk4, drive)}
-    # lifting: its IC as filed and run long (it stalls); the drop from ropesim's start, and 1 nm off it
-    print("  lifting: MoorDyn's IC, the drop, the drop from 1 nm off ...", flush=True)
+    return {"dynamic": _run_record(rk2, rk4, drive)}
+
+
+def regenerate_lifting(arrays: dict) -> dict:
+    """lifting: its IC as filed and run long (it stalls); the drop from ropesim's start, and 1 nm off it."""
     s = read_system("lifting")
     ics = {"filed": moordyn_ic("lifting"), "long": moordyn_ic("lifting", {"TmaxIC": 1000, "threshIC": 1e-7,
                                                                           "dtIC": 10.0})}
@@ -133,32 +156,52 @@ def regenerate() -> None:
     _store_run(arrays, "lifting", rk4, half, every_positions=POSITIONS_EVERY["lifting"])
     arrays["lifting_perturbed_points"] = off.points
     arrays["lifting_perturbed_fairlead"] = off.fairlead_state
-    record["cases"]["lifting"] = {
+    return {
         "ic": {k: {"fairlead_tension_N": ic["fairlead"].tolist(), "point_m": ic["points"].tolist(),
                    "init_wall_s": ic["init_wall"]} for k, ic in ics.items()},
         "ic_long_options": {"TmaxIC": 1000, "threshIC": 1e-7, "dtIC": 10.0},
         "dynamic": _run_record(rk4, half, None), "perturbation_m": PERTURBATION,
         "perturbed_node": 10}
-    record["fields"] = {
-        "<case>_t": "s, (F,): the frames, every coupling instant",
-        "<case>_fairlead": "N, (F, L): each line's end-B segment |T + Td| from MoorDyn's state at the frame, a coupled "
-                           "end at the secant velocity of the interval ending there (the file's scheme and dtM)",
-        "<case>_fairlead_reported": "N, (F, L): GetLineFairTen of the same run (its last force evaluation)",
-        "<case>_anchor": "N, (F, L): each line's end-A segment |T + Td| from the state",
-        "<case>_points": "m, (F, P, 3): every point's position (MoorDyn frame), where a point is free",
-        "<case>_body_r6": "m, rad, (F, B, 6): each body's position and angles (R = Rx Ry Rz)",
-        "<case>_body_v6": "m/s, rad/s, (F, B, 6): its velocity and angular velocity",
-        "<case>_positions": "m, (F', nodes, 3): every node, line after line, every POSITIONS_EVERY-th frame",
-        "<case>_converged_*": "the same from MoorDyn's RK4 at half the file's step (lifting: the file's RK4 at half "
-                              "its step)",
-        "lines_start, lifting_start": "m, (nodes, 3): the state both codes start from (ropesim's static shape for "
-                                      "lines, its straight start for lifting), MoorDyn frame",
-        "<case>_ic_<kind>_positions": "m, (nodes, 3): MoorDyn's IC state",
-        "lifting_perturbed_*": "MoorDyn's lifting run started with node 10 moved 1 nm down",
-    }
-    np.savez_compressed(f"{STORED}.npz", **arrays)
-    Path(f"{STORED}.json").write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
-    print(f"wrote {STORED}.npz, {STORED}.json")
+
+
+def regenerate_spar(arrays: dict) -> dict:
+    """spar (the speed benchmark's case): released from the lines' static shape, RK4 at dtM and at dtM / 2, and
+    RK4 at dtM with the body's Ca = SPAR_RUN["ca"] (MoorDyn's added mass in its centripetal force)."""
+    s = read_system("spar")
+    start = static_positions("lines")
+    t_end, dt_out = SPAR_RUN["t_end"], SPAR_RUN["dt_out"]
+    rk4 = run_moordyn_system("spar", None, t_end, dt_out, start=start, options={"tScheme": "RK4"})
+    half = run_moordyn_system("spar", None, t_end, dt_out, start=start,
+                              options={"tScheme": "RK4", "dtM": s.file.dtM / 2})
+    added = run_moordyn_system("spar", None, t_end, dt_out, start=start, options={"tScheme": "RK4"},
+                               body_ca=SPAR_RUN["ca"])
+    _store_run(arrays, "spar", rk4, half)
+    arrays["spar_added_mass_body_r6"] = added.body_r6
+    arrays["spar_added_mass_fairlead"] = added.fairlead_state
+    return {"dynamic": _run_record(rk4, half, None), "run": SPAR_RUN}
+
+
+REGENERATE = {"lines": regenerate_lines, "rotatingBody": regenerate_rotating, "lifting": regenerate_lifting,
+              "spar": regenerate_spar}
+
+FIELDS = {
+    "<case>_t": "s, (F,): the frames, every coupling instant",
+    "<case>_fairlead": "N, (F, L): each line's end-B segment |T + Td| from MoorDyn's state at the frame, a coupled "
+                       "end at the secant velocity of the interval ending there (the file's scheme and dtM)",
+    "<case>_fairlead_reported": "N, (F, L): GetLineFairTen of the same run (its last force evaluation)",
+    "<case>_anchor": "N, (F, L): each line's end-A segment |T + Td| from the state",
+    "<case>_points": "m, (F, P, 3): every point's position (MoorDyn frame), where a point is free",
+    "<case>_body_r6": "m, rad, (F, B, 6): each body's position and angles (R = Rx Ry Rz)",
+    "<case>_body_v6": "m/s, rad/s, (F, B, 6): its velocity and angular velocity",
+    "<case>_positions": "m, (F', nodes, 3): every node, line after line, every POSITIONS_EVERY-th frame",
+    "<case>_converged_*": "the same from MoorDyn's RK4 at half the file's step (lifting: the file's RK4 at half "
+                          "its step)",
+    "lines_start, lifting_start": "m, (nodes, 3): the state both codes start from (ropesim's static shape for "
+                                  "lines, its straight start for lifting), MoorDyn frame",
+    "<case>_ic_<kind>_positions": "m, (nodes, 3): MoorDyn's IC state",
+    "lifting_perturbed_*": "MoorDyn's lifting run started with node 10 moved 1 nm down",
+    "spar_added_mass_*": "MoorDyn's spar run with the body's Ca set to 1 (its file's is 0)",
+}
 
 
 def _store_run(arrays: dict, name: str, run, converged, every_positions: int = 1) -> None:
@@ -277,6 +320,49 @@ def lifting_results(arrays: dict, record: dict) -> dict:
     return out
 
 
+def spar_signals(traj) -> np.ndarray:
+    """ropesim's spar run as (F, 6): the three fairlead tensions (N), the body's heave and surge (m), its pitch
+    (rad, about MoorDyn's y), MoorDyn's axes."""
+    from ropesim.model.rotation import rotation_matrix
+
+    fair = ropesim_fairlead_tensions("spar", traj, None)
+    x = from_ropesim(np.asarray(traj.body_x)[:, 0])
+    r = rotation_matrix(np.asarray(traj.body_q)[:, 0])
+    return np.column_stack([fair, x[:, 2], x[:, 0], np.arctan2(r[:, 0, 1], r[:, 0, 0])])
+
+
+def spar_moordyn_signals(fairlead, r6) -> np.ndarray:
+    return np.column_stack([fairlead, r6[:, 0, 2], r6[:, 0, 0], r6[:, 0, 4]])
+
+
+SPAR_SIGNALS = ("line 1 fairlead tension", "line 2 fairlead tension", "line 3 fairlead tension", "body heave",
+                "body surge", "body pitch")
+
+
+def spar_results(arrays: dict, record: dict) -> dict:
+    s = read_system("spar")
+    dt = s.file.dtM
+    start = static_positions("lines")
+    kw = {"t_end": SPAR_RUN["t_end"], "interval": SPAR_RUN["dt_out"]}
+    print(f"  spar: rk4 at {dt * 1e3:g} and {dt * 500:g} ms, and with the body's Ca = {SPAR_RUN['ca']:g} ...",
+          flush=True)
+    runs = {k: run_system_from("spar", start, dt=dt / k, **kw) for k in (1, 2)}
+    added = run_system_from("spar", start, dt=dt, changes=spar_changes(SPAR_RUN["ca"]), **kw)
+    md = spar_moordyn_signals(arrays["spar_fairlead"], arrays["spar_body_r6"])
+    conv = spar_moordyn_signals(arrays["spar_converged_fairlead"], arrays["spar_converged_body_r6"])
+    md_added = spar_moordyn_signals(arrays["spar_added_mass_fairlead"], arrays["spar_added_mass_body_r6"])
+    rs = {k: spar_signals(traj) for k, traj in runs.items()}
+    rs_added = spar_signals(added)
+    t = np.asarray(runs[1].t)
+    return {"dt": dt, "t": t, "md": md, "rs": rs[1], "md_added": md_added, "rs_added": rs_added,
+            "rows": [differences(md[:, k], rs[1][:, k]) for k in range(6)],
+            "half": [differences(conv[:, k], rs[2][:, k]) for k in range(6)],
+            "md_step": [differences(conv[:, k], md[:, k]) for k in range(6)],
+            "added_rows": [differences(md_added[:, k], rs_added[:, k]) for k in range(6)],
+            "excess": moordyn_centripetal_excess(added, SPAR_RUN["ca"]),
+            "wall": float(runs[1].summary["wall_time_s"]), "md_wall": record["cases"]["spar"]["dynamic"]["wall_time_s"]}
+
+
 def first_time_above(t, err, level) -> float:
     """The first time (s) at which err exceeds level (inf if never)."""
     hit = np.flatnonzero(np.asarray(err) > level)
@@ -351,6 +437,24 @@ def dynamic_table(lines: dict | None, rotating: dict | None, lifting: dict | Non
     return "\n".join(rows)
 
 
+def spar_table(spar: dict) -> str:
+    rows = [("| signal | range | ropesim − MoorDyn: RMS (max) | RMS / range | at dt / 2 against MoorDyn at dtM / 2 | "
+            f"the body's Ca = {SPAR_RUN['ca']:g}: RMS / range |"), "| --- | --- | --- | --- | --- | --- |"]
+    for k, name in enumerate(SPAR_SIGNALS):
+        x, h, a = spar["rows"][k], spar["half"][k], spar["added_rows"][k]
+        unit, scale = (("kN", 1e-3) if k < 3 else ("m", 1.0) if k < 5 else ("mrad", 1e3))
+        rows.append(f"| {name} | {x['range'] * scale:.4g} {unit} | {x['rms'] * scale:.2e} {unit} "
+                    f"({x['max'] * scale:.2e} {unit}) | {rel(x['rms_of_range'])} | {rel(h['rms_of_range'])} | "
+                    f"{rel(a['rms_of_range'])} |")
+    heave = spar["md_added"][:, 3] - spar["rs_added"][:, 3]
+    rows.append("")
+    rows.append(f"With the body's Ca = {SPAR_RUN['ca']:g}, MoorDyn's heave − ropesim's at {spar['t'][-1]:g} s: "
+                f"{heave[-1] * 1e3:.3f} mm; MoorDyn's added mass in its centripetal force predicts "
+                f"{spar['excess'][-1] * 1e3:.3f} mm (moordyn_centripetal_excess). Wall time: ropesim "
+                f"{spar['wall']:.2f} s, MoorDyn {spar['md_wall']:.2f} s (RK4, {spar['dt'] * 1e3:g} ms).")
+    return "\n".join(rows)
+
+
 def explanation_rows(lines: dict | None, rotating: dict | None, lifting: dict | None) -> str:
     out = []
     if lines:
@@ -387,14 +491,15 @@ def explanation_rows(lines: dict | None, rotating: dict | None, lifting: dict | 
 # ------------------------------------------------------------------------------------------------ figure
 
 
-def draw(lines: dict | None, rotating: dict | None, lifting: dict | None, path: Path) -> None:
+def draw(lines: dict | None, rotating: dict | None, lifting: dict | None, path: Path, spar: dict | None = None) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    cols = [c for c in (("lines", lines), ("rotatingBody", rotating), ("lifting", lifting)) if c[1] is not None]
-    fig, axes = plt.subplots(2, len(cols), figsize=(4.3 * len(cols), 5.6), layout="constrained", squeeze=False,
+    cols = [c for c in (("lines", lines), ("rotatingBody", rotating), ("lifting", lifting), ("spar", spar))
+            if c[1] is not None]
+    fig, axes = plt.subplots(2, len(cols), figsize=(4.0 * len(cols), 5.6), layout="constrained", squeeze=False,
                              sharex="col", height_ratios=(2, 1))
     for col, (name, r) in enumerate(cols):
         top, bottom = axes[0, col], axes[1, col]
@@ -421,6 +526,20 @@ def draw(lines: dict | None, rotating: dict | None, lifting: dict | None, path: 
             bottom.plot(t[1:], rs[1:] - md[1:], color="C3", lw=0.8, label="line 7 tension [N]")
             bottom.plot(t, 1e4 * r[("rk4", 1)]["angle"], color="C1", lw=0.8, label="orientation [1e-4 rad]")
             bottom.set_ylabel("ropesim − MoorDyn")
+        elif name == "spar":
+            t = r["t"]
+            top.plot(t, r["md"][:, 3], color="C0", lw=2.4, alpha=0.5, label="heave, MoorDyn (RK4, 2 ms)")
+            top.plot(t, r["rs"][:, 3], color="C3", lw=0.8, ls="--", label="ropesim (rk4, 2 ms)")
+            top.plot(t, 100 * r["md"][:, 5], color="C2", lw=2.4, alpha=0.5, label="pitch [10 mrad], MoorDyn")
+            top.plot(t, 100 * r["rs"][:, 5], color="C3", lw=0.8, ls="--")
+            top.set_title("a free spar on lines.txt's chains, released", fontsize=9)
+            top.set_ylabel("heave [m]")
+            bottom.plot(t, 1e3 * (r["rs"][:, 3] - r["md"][:, 3]), color="C3", lw=0.8, label="ropesim − MoorDyn")
+            bottom.plot(t, 1e3 * (r["rs_added"][:, 3] - r["md_added"][:, 3]), color="C1", lw=0.8,
+                        label=f"the same, body Ca = {SPAR_RUN['ca']:g}")
+            bottom.plot(t, -1e3 * r["excess"], color="k", lw=0.8, ls=":",
+                        label="MoorDyn's added-mass\ncentripetal force, integrated")
+            bottom.set_ylabel("heave difference [mm]")
         else:
             t = r["t"]
             top.plot(t, -r["md_z"] - 100.0, color="C0", lw=2.4, alpha=0.5, label="MoorDyn (RK4, 0.1 ms)")
@@ -463,20 +582,26 @@ def main(argv: list[str] | None = None) -> int:
     started = time.perf_counter()
     if args.regenerate:
         print("MoorDyn runs:", flush=True)
-        regenerate()
+        regenerate(names)
     arrays, record = load_stored()
     print(f"MoorDyn {record['moordyn_version']} (stored), ropesim {ropesim.__version__}:", flush=True)
     lines = lines_results(arrays, record) if "lines" in names else None
     rotating = rotating_results(arrays, record) if "rotatingBody" in names else None
     lifting = lifting_results(arrays, record) if "lifting" in names else None
+    spar = spar_results(arrays, record) if "spar" in names else None
     if lines or lifting:
         print("\n## Static\n")
         print(static_table(lines, lifting))
-    print("\n## Dynamic\n")
-    print(dynamic_table(lines, rotating, lifting))
-    print("\n## Where the differences come from\n")
-    print(explanation_rows(lines, rotating, lifting))
-    draw(lines, rotating, lifting, args.figure)
+    if lines or rotating or lifting:
+        print("\n## Dynamic\n")
+        print(dynamic_table(lines, rotating, lifting))
+    if spar:
+        print("\n## A free spar (RK4 at equal steps)\n")
+        print(spar_table(spar))
+    if lines or rotating or lifting:
+        print("\n## Where the differences come from\n")
+        print(explanation_rows(lines, rotating, lifting))
+    draw(lines, rotating, lifting, args.figure, spar)
     print(f"\nwrote {args.figure}")
     print(f"total {time.perf_counter() - started:.0f} s")
     return 0

@@ -18,6 +18,10 @@ one description:
   100 m below a fixed point. MoorDyn's own test winds the line in (``SetLineUnstretchedLengthVel``); ropesim has no
   winch (a line's length is fixed), so here the mass drops the 0.5 m of slack its file starts with and bounces on
   the stiff line (EA = 1e9 N): a snap load, every segment slack at the start.
+- **spar** (``spar_free.txt``, not MoorDyn's: the speed benchmark's case): lines.txt's chains on a free body, a
+  spar of OC3-Hywind's mass and inertia, its centre of gravity 78 m down and 0.5 m off its axis, translational and
+  rotational drag, no added mass (MoorDyn would put it in the centripetal force: :func:`moordyn_centripetal_excess`),
+  10 % too buoyant for its lines; released from their static shape with the body held (:func:`run_system_from`).
 
 Equal physics, item by item (MOORDYN_CONVENTIONS.md has MoorDyn's side, with its source lines):
 
@@ -59,8 +63,9 @@ from .moordyn_own_cases import moordyn_ba, set_line_state
 DATA = Path(__file__).resolve().parent.parent / "data" / "moordyn"
 CASES_DIR = DATA / "cases"
 STORED = DATA / "own_systems"          # .npz and .json
-SYSTEMS = ("lines", "rotatingBody", "lifting")
-FILES = {"lines": "lines.txt", "rotatingBody": "rotatingBody.txt", "lifting": "lifting.txt"}
+SYSTEMS = ("lines", "rotatingBody", "lifting", "spar")
+FILES = {"lines": "lines.txt", "rotatingBody": "rotatingBody.txt", "lifting": "lifting.txt",
+         "spar": "spar_free.txt"}   # spar: not MoorDyn's, the speed benchmark's (scripts/bench_systems_moordyn.py)
 EXTRA_FILES = {"lines": ("lines.txt.ic",)}
 
 #: MoorDyn's frame to ropesim's: (x, y, z) -> (x, z, -y), a rotation by -90 degrees about x.
@@ -469,6 +474,20 @@ def run_system(name: str, drive: Drive | None, **kw):
     return ropesim.simulate(system_scene(name, drive, **kw))
 
 
+def run_system_from(name: str, x, **kw):
+    """ropesim's Trajectory of a case started from the node positions x (nodes, 3; MoorDyn's frame, line after line),
+    at rest, its bodies where the file puts them (a system's scene starts only from its ``lines`` or ``equilibrium``
+    shape, so the built model's start is replaced); arguments as :func:`system_scene_dict`."""
+    from ropesim.integrate.grid import TimeGrid
+    from ropesim.model.build import build
+    from ropesim.run import _run_in_memory
+
+    scene = system_scene(name, None, **kw)
+    model = build(scene)
+    model.x0[:] = to_ropesim(x).T
+    return _run_in_memory(model, TimeGrid.of(scene), False, None)
+
+
 def static_positions(name: str, **kw) -> np.ndarray:
     """ropesim's static shape of a case (``initial.shape = "equilibrium"``), every node (nodes, 3) in MoorDyn's
     frame, line after line."""
@@ -553,6 +572,47 @@ def drive_of(name: str, t_end: float | None = None) -> Drive | None:
 #: lifting's stored drop: its length (s) and output interval (s).
 LIFTING_RUN = {"t_end": 3.0, "dt_out": 0.01}
 
+#: spar's stored release: its length (s), output interval (s), and the body's Ca of the run that shows MoorDyn's
+#: added mass in its centripetal force (:func:`moordyn_centripetal_excess`; the file's own Ca is 0).
+SPAR_RUN = {"t_end": 30.0, "dt_out": 0.1, "ca": 1.0}
+
+
+def with_body_ca(text: str, ca: float) -> str:
+    """A MoorDyn file's text with its (one) body's Ca, the last column of its row, set to ``ca``."""
+    rows = text.splitlines(keepends=True)
+    i = next(k for k, row in enumerate(rows) if row.split()[1:2] == ["free"])
+    words = rows[i].split()
+    rows[i] = " ".join([*words[:-1], repr(ca)]) + "\n"
+    return "".join(rows)
+
+
+def spar_changes(ca: float) -> dict:
+    """ropesim's scene change giving the spar's body MoorDyn's added mass rho V Ca on every axis."""
+    body = system_scene_dict("spar", None)["bodies"][0]
+    return {"bodies": [{**body, "added_mass": [1025.0 * body["volume"] * ca] * 3}]}
+
+
+def moordyn_centripetal_excess(traj, ca: float) -> np.ndarray:
+    """What MoorDyn's body adds to ropesim's physics on the spar, from ropesim's run: its centripetal force of the
+    offset centre of gravity is M_t w x (w x c) with M_t its whole translational mass, added mass included
+    (``Body::doRHS``), where the rigid body's is m w x (w x c) (the added mass acts at the reference point). The
+    excess, -rho V Ca w x (w x c), integrated twice over the heave's mass m + rho V Ca (the lines' restoring
+    force and the drag left out over a short window): MoorDyn's heave minus ropesim's (F,), m."""
+    from ropesim.model.rotation import rotation_matrix
+
+    s = read_system("spar")
+    (body,) = s.bodies
+    t = np.asarray(traj.t)
+    w = np.asarray(traj.body_w)[:, 0]
+    c = np.einsum("fij,j->fi", rotation_matrix(np.asarray(traj.body_q)[:, 0]), to_ropesim(body.cg))
+    added = s.file.rho_w * body.volume * ca
+    excess = from_ropesim(-added * np.cross(w, np.cross(w, c)))[:, 2] / (body.mass + added)
+
+    def integral(f):
+        return np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(t))])
+
+    return integral(integral(excess))
+
 
 # ------------------------------------------------------------------------------------------------ MoorDyn, live
 
@@ -584,13 +644,16 @@ class MoorDynSystemRun:
     extra: dict = field(default_factory=dict)
 
 
-def moordyn_text(name: str, options: dict | None = None, ic_file: bool = True) -> str:
+def moordyn_text(name: str, options: dict | None = None, ic_file: bool = True, body_ca: float | None = None) -> str:
     """The case's MoorDyn file with the harness's quiet options and ``options`` set; without ``ic_file``, its
     ``fileIC`` option left out (MoorDyn loads that saved state into its integrator even with ``Init_NoIC``, so a
-    start set by :func:`set_line_state`, which edits the state the lines report, would not be the one it steps)."""
+    start set by :func:`set_line_state`, which edits the state the lines report, would not be the one it steps);
+    with ``body_ca``, its body's Ca set to that (:func:`with_body_ca`)."""
     from .moordyn_harness import QUIET_OPTIONS, set_options
 
     text = set_options((CASES_DIR / FILES[name]).read_text(encoding="utf-8"), {**QUIET_OPTIONS, **(options or {})})
+    if body_ca is not None:
+        text = with_body_ca(text, body_ca)
     if not ic_file:
         text = "".join(row for row in text.splitlines(keepends=True)
                        if not (len(row.split()) >= 2 and row.split()[1].lower() in ("fileic", "icfile")))
@@ -603,7 +666,7 @@ def _extra_files(name: str) -> dict:
 
 def run_moordyn_system(name: str, drive: Drive | None, t_end: float, dt_out: float, ic: bool = False,
                        start: np.ndarray | None = None, options: dict | None = None,
-                       every: int = 1, ic_file: bool = True) -> MoorDynSystemRun:
+                       every: int = 1, ic_file: bool = True, body_ca: float | None = None) -> MoorDynSystemRun:
     """MoorDyn on a case: its IC (``ic``) or its initial layout (``Init_NoIC``), then, with ``start`` (nodes, 3),
     every line's nodes set there at rest (:func:`set_line_state`); then ``t_end`` seconds coupled every ``dt_out``
     (the coupled points at ``drive.path`` with the secant velocity, as the harness does), recording every
@@ -623,7 +686,8 @@ def run_moordyn_system(name: str, drive: Drive | None, t_end: float, dt_out: flo
     system = None
     try:
         path = folder / FILES[name]
-        path.write_text(moordyn_text(name, options, ic_file=ic_file and start is None), encoding="utf-8")
+        path.write_text(moordyn_text(name, options, ic_file=ic_file and start is None, body_ca=body_ca),
+                        encoding="utf-8")
         for f, data in _extra_files(name).items():
             (folder / f).write_bytes(data)
         n_coupled = len(s.coupled)
