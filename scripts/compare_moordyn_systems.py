@@ -69,7 +69,7 @@ from references.moordyn_systems import (
 
 FIGURE = ROOT / "docs" / "images" / "moordyn_systems.png"
 TIGHT_IC = {"threshIC": 1e-8, "TmaxIC": 4000}
-POSITIONS_EVERY = {"lines": 50, "lifting": 30}   # every node is stored at every this many frames (5 s, 0.3 s)
+POSITIONS_EVERY = {"lines": 50, "lifting": 30, "spar": 50}   # every node stored every this many frames (5, 0.3, 5 s)
 PERTURBATION = 1e-9      # m: lifting's start moved this far (one node, along the line) for MoorDyn against itself
 
 
@@ -175,7 +175,7 @@ def regenerate_spar(arrays: dict) -> dict:
                               options={"tScheme": "RK4", "dtM": s.file.dtM / 2})
     added = run_moordyn_system("spar", None, t_end, dt_out, start=start, options={"tScheme": "RK4"},
                                body_ca=SPAR_RUN["ca"])
-    _store_run(arrays, "spar", rk4, half)
+    _store_run(arrays, "spar", rk4, half, every_positions=POSITIONS_EVERY["spar"])
     arrays["spar_added_mass_body_r6"] = added.body_r6
     arrays["spar_added_mass_fairlead"] = added.fairlead_state
     return {"dynamic": _run_record(rk4, half, None), "run": SPAR_RUN}
