@@ -424,9 +424,9 @@ def test_cfl_time_step():
 
 
 def stored_cases():
-    """The stored reference cases: names of tests/data/moordyn/<case>.json (not own_cases.json, the further runs
-    of scripts/compare_moordyn_cases.py, stored in their own layout)."""
-    return sorted(p.stem for p in DATA.glob("*.json") if p.stem != "own_cases")
+    """The stored reference cases: names of tests/data/moordyn/<case>.json (not own_cases.json and own_systems.json,
+    the further runs of scripts/compare_moordyn_cases.py and compare_moordyn_systems.py, in their own layouts)."""
+    return sorted(p.stem for p in DATA.glob("*.json") if p.stem not in ("own_cases", "own_systems"))
 
 
 def test_stored_references_exist_and_are_small():
