@@ -10,14 +10,14 @@ Three measurements, each in new processes, every cold case with its own empty ``
 - **warm whole process**: ``ropesim run helicopter_uniform`` with a warm cache against a minimal Numba
   script doing the same steps (the write-up's towed rope, 3000 symplectic Euler steps, a frame every 10 saved
   to an .npz), paired: the two alternate, round by round, and the ratio is the median of the per-round ratios
-  of wall time.
+  of wall time (and of CPU time, steadier on a shared machine). ``--warm-only`` measures only this.
 
 With ``--against REV`` the first two run for that revision too (checked out in a temporary worktree),
 interleaved case by case with this checkout so both see the same machine load; the tables give both and
 their ratio. CPU time is kept beside wall time because the machine is shared: a loaded machine stretches wall
 time far more than CPU time.
 
-    python scripts/bench_first_run.py [--against REV] [--rounds 1] [--scenes a,b] [--json FILE]
+    python scripts/bench_first_run.py [--against REV] [--rounds 1] [--scenes a,b] [--warm-only] [--json FILE]
 """
 
 from __future__ import annotations
@@ -113,7 +113,8 @@ def warm_process(rounds: int, work: Path) -> dict:
     script = work / "minimal.py"
     script.write_text(MINIMAL)
     env = dict(os.environ, PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=tempfile.mkdtemp(prefix="cache-", dir=work),
-               MPLBACKEND="Agg")
+               MPLBACKEND="Agg", PYTHONPYCACHEPREFIX=str(work / "pycache"))
+    env.pop("PYTHONDONTWRITEBYTECODE", None)   # warm means bytecode too, as an installed package has it
     ropesim = [sys.executable, "-m", "ropesim", "run", "helicopter_uniform", "--out", str(work / "uniform"),
                "--quiet", "--force"]
     minimal = [sys.executable, str(script), str(work / "minimal.npz")]
@@ -123,7 +124,8 @@ def warm_process(rounds: int, work: Path) -> dict:
         pair = [("ropesim", ropesim), ("minimal", minimal)]
         got = {name: timed(cmd, env, work) for name, cmd in (pair if r % 2 == 0 else pair[::-1])}
         rows.append(got)
-    return {"rounds": rows, "ratio": statistics.median(r["ropesim"]["wall"] / r["minimal"]["wall"] for r in rows)}
+    return {"rounds": rows, "ratio": statistics.median(r["ropesim"]["wall"] / r["minimal"]["wall"] for r in rows),
+            "cpu_ratio": statistics.median(r["ropesim"]["cpu"] / r["minimal"]["cpu"] for r in rows)}
 
 
 def main() -> None:
@@ -132,6 +134,7 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=1, help="cold measurements per case (the median is shown)")
     parser.add_argument("--scenes", help="comma-separated built-in scenes (default: all)")
     parser.add_argument("--warm-rounds", type=int, default=15, help="paired rounds of the warm whole process")
+    parser.add_argument("--warm-only", action="store_true", help="only the warm whole process (no cold cases)")
     parser.add_argument("--json", metavar="FILE", help="also write every measurement to FILE")
     args = parser.parse_args()
     sys.path.insert(0, str(ROOT))
@@ -152,7 +155,7 @@ def main() -> None:
         try:
             cases = [("first_step", s, first_step(s, work / "run")) for s in scenes]
             cases.append(("accuracy", "helicopter_mass", accuracy(work / "accuracy")))
-            for r in range(args.rounds):
+            for r in range(0 if args.warm_only else args.rounds):
                 for kind, name, cmd in cases:
                     order = list(trees.items()) if r % 2 == 0 else list(trees.items())[::-1]
                     for who, tree in order:
@@ -177,6 +180,8 @@ def report(results: dict, trees: list[str], against: str | None) -> None:
     console = Console(width=150)
     for kind, title in (("first_step", "First step of a first run (empty cache): CPU seconds of the whole process"),
                         ("accuracy", "`ropesim accuracy helicopter_mass`, every method, --repeats 1")):
+        if not results[kind]:
+            continue
         table = Table(title=title)
         table.add_column("case")
         for who in trees:
@@ -202,7 +207,7 @@ def report(results: dict, trees: list[str], against: str | None) -> None:
         table.add_row(f"{'ropesim run' if name == 'ropesim' else 'minimal Numba script'}",
                       f"{statistics.median(r[name]['wall'] for r in warm['rounds']):.2f}",
                       f"{statistics.median(r[name]['cpu'] for r in warm['rounds']):.2f}")
-    table.add_row("ratio (median of rounds)", f"{warm['ratio']:.2f}", "")
+    table.add_row("ratio (median of rounds)", f"{warm['ratio']:.2f}", f"{warm['cpu_ratio']:.2f}")
     console.print(table)
 
 
