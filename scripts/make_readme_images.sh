@@ -2,10 +2,11 @@
 # Regenerate the docs' pictures of the built-in scenarios (docs/images/scenarios/) with ropesim's own
 # commands: the towed ropes as overlaid frames seen from the helicopter, run long enough to reach their steady
 # shapes (plus the plot of the one with the end mass), the string shooters as small GIFs of their default runs
-# (the real one, string_shooter_real, slowed down, with a frame sheet), and the moorings and the beam (frames,
-# the chain's swing as a GIF, and each one's plot with its tensions).
+# (the real one, string_shooter_real, slowed down, with a frame sheet), the moorings and the beam (frames,
+# the chain's swing as a GIF, and each one's plot with its tensions), and the systems of lines (each one's
+# frames, an animation and its plot).
 #
-#     scripts/make_readme_images.sh        # about a minute and a half on two cores; prints the pictures' total size
+#     scripts/make_readme_images.sh        # about three minutes on two cores; prints the pictures' total size
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=docs/images/scenarios
@@ -54,4 +55,27 @@ ropesim run cantilever_beam -o "$runs/cantilever_beam" -q
 ropesim frames "$runs/cantilever_beam" --overlay --times 0,0.1,0.2,0.3,0.44 --width 760 \
     -o "$out/cantilever_beam.png" -q
 ropesim plot "$runs/cantilever_beam" -o "$out/cantilever_beam_plot.png" -q
+
+# the systems of lines: the clump weight's drop and bounce, the driven and the free spar (seen from the side,
+# where the chains lift and lay down), and the sling load's swing (from the side) and turn (in 3-D)
+ropesim run clump_weight -o "$runs/clump_weight" -q
+ropesim frames "$runs/clump_weight" --overlay --times 0,0.2,0.4,0.6,0.8,1.0 --width 640 -o "$out/clump_weight.png" -q
+ropesim animate "$runs/clump_weight" --speed 0.5 --end 2 --fps 20 --size 400 -o "$out/clump_weight.gif" -q
+ropesim plot "$runs/clump_weight" -o "$out/clump_weight_plot.png" -q
+ropesim run spread_mooring -o "$runs/spread_mooring" -q
+ropesim frames "$runs/spread_mooring" --times 60 --width 760 -o "$out/spread_mooring.png" -q
+ropesim animate "$runs/spread_mooring" --view xy --speed 10 --fps 10 --size 400 -o "$out/spread_mooring.gif" -q
+ropesim plot "$runs/spread_mooring" -o "$out/spread_mooring_plot.png" -q
+ropesim run spread_mooring_free -o "$runs/spread_mooring_free" -q
+ropesim frames "$runs/spread_mooring_free" --overlay --view xy --times 0,50,100,150,300,600 --width 760 \
+    -o "$out/spread_mooring_free.png" -q
+ropesim animate "$runs/spread_mooring_free" --view xy --end 300 --speed 30 --fps 10 --size 400 \
+    -o "$out/spread_mooring_free.gif" -q
+ropesim plot "$runs/spread_mooring_free" -o "$out/spread_mooring_free_plot.png" -q
+ropesim run helicopter_sling -o "$runs/helicopter_sling" -q
+ropesim frames "$runs/helicopter_sling" --follow --overlay --view xy --times 0,5,10,15,20,25,30 --width 640 \
+    -o "$out/helicopter_sling.png" -q
+ropesim animate "$runs/helicopter_sling" --follow --end 48 --speed 4 --fps 5 --size 360 \
+    -o "$out/helicopter_sling.gif" -q
+ropesim plot "$runs/helicopter_sling" -o "$out/helicopter_sling_plot.png" -q
 du -ch "$out"/* | tail -1

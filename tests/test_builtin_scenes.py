@@ -105,12 +105,18 @@ def test_new_writes_an_annotated_copy_that_loads_as_the_same_scene(tmp_path, mon
     for line in original.splitlines():   # every comment of the original is kept
         if line.lstrip().startswith("#"):
             assert line in text, line
-    if load_scene(written).rope.physical:   # meaning and unit above each key
+    if load_scene(written).is_system:   # a line type's keys, a rigid body's (not a rope's point body's)
+        assert "# axial stiffness EA [N]\nEA = " in text
+        if "[[bodies]]" in original:
+            assert "# the body's name, which points name to sit on it\nid = " in text
+            assert "its added-mass coefficient" not in text   # a point body's ca, no rigid body's key
+        assert "# initial shape; one of lines, equilibrium" in text or "[initial]" not in original
+    elif load_scene(written).rope.physical:   # meaning and unit above each key
         assert "# axial stiffness EA (physical form) [N]\nEA = " in text
     else:
         assert "# spring constant k between neighbours [N/m]\nstiffness = 5000.0" in text
     assert "# integration method; one of symplectic_euler, verlet," in text
-    if source.startswith("helicopter"):   # the optional keys left out, at their defaults, commented out
+    if source.startswith("helicopter") and not load_scene(written).is_system:   # the optional keys left out, at their defaults, commented out
         assert "# closed = false   # true for a closed loop" in text
 
 

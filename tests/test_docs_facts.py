@@ -13,7 +13,8 @@ from ropesim.scene.loader import SceneError, load_scene
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 NUMBERS = {"eight": 8, "nine": 9, "ten": 10, "eleven": 11, "twelve": 12, "thirteen": 13, "fourteen": 14,
-           "fifteen": 15, "sixteen": 16}
+           "fifteen": 15, "sixteen": 16,
+           "seventeen": 17, "eighteen": 18, "nineteen": 19, "twenty": 20}
 
 
 def test_the_scene_count_on_getting_started_is_the_number_of_built_in_scenes():

@@ -76,10 +76,16 @@ def test_every_built_in_scene_opens_offline_draws_and_plays(browser, builtin_run
         assert_clean(opened)
         (info,) = opened.info()
         assert info["name"] == name and info["frames"] == traj.frames == page.frames[0]
-        assert info["lines"] == [{"name": "rope", "nodes": traj.nodes, "closed": traj.scene.rope.closed,
-                                  "fields": ["tension", "strain", "speed"]}]
+        if traj.scene.is_system:   # every line by its id, every rigid body
+            assert [(line["name"], line["nodes"]) for line in info["lines"]] == [
+                (line.id, line.nodes) for line in traj.scene.lines]
+            assert all(line["fields"] == ["tension", "strain", "speed"] for line in info["lines"])
+            assert info["bodies"] == [body.id for body in traj.scene.rigid_bodies]
+        else:
+            assert info["lines"] == [{"name": "rope", "nodes": traj.nodes, "closed": traj.scene.rope.closed,
+                                      "fields": ["tension", "strain", "speed"]}]
+            assert info["bodies"] == (["thrower box"] if traj.scene.thrower else [])
         assert info["shapes"] == ["guide circle"] * len(traj.scene.guides)
-        assert info["bodies"] == (["thrower box"] if traj.scene.thrower else [])
         assert info["seabed"] == (traj.scene.seabed is not None) and not info["water"]
         assert drawn_fraction(picture(opened.canvas_png())) > 0.003, f"{name}: the canvas is blank"
         state = opened.state()
@@ -215,8 +221,9 @@ def test_every_built_in_scene_at_its_full_length(browser, name, tmp_path):
     (info,) = opened.info()
     assert info["frames"] == traj.frames
     opened.page.keyboard.press("End")
-    shown = np.array(opened.page.evaluate("window.ropesim.positions(0, 0)"), dtype=float)
-    assert np.abs(shown - np.asarray(traj.x[-1])).max() <= info["bound"] * (1 + 1e-6)
+    for k, line in enumerate(traj.lines):   # a rope is its one line; a system's lines each have their nodes
+        shown = np.array(opened.page.evaluate(f"window.ropesim.positions(0, {k})"), dtype=float)
+        assert np.abs(shown - np.asarray(traj.line(line).positions[-1])).max() <= info["bound"] * (1 + 1e-6)
     assert drawn_fraction(picture(opened.canvas_png())) > 0.003
     opened.page.close()
 

@@ -91,7 +91,7 @@ def resolve(arg: str | Path) -> SceneSource:
 # ------------------------------------------------------------------------ `ropesim new`: an annotated copy
 
 _KEY = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)\s*=")
-_HEADER = re.compile(r"^\[(\[?)\s*([A-Za-z_][A-Za-z0-9_]*)\s*\]\]?\s*(#.*)?$")
+_HEADER = re.compile(r"^\[(\[?)\s*([A-Za-z_][A-Za-z0-9_]*)(?:\.[A-Za-z0-9_-]+)?\s*\]\]?\s*(#.*)?$")
 NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 _OUR_HEADER = re.compile(r"^# \S+: a scene to edit, copied from .* by `ropesim new`")
 HEADER_LINES = 5  # the header annotated_copy writes, with the blank line after it
@@ -105,12 +105,21 @@ def _keys(table: str | None, raw: dict) -> dict:
 
     if table is None:
         return {k: (spec, MISSING) for k, spec in S.TOP_LEVEL_SCALARS.items()}
-    cls = S.TABLES.get(table) or S.ARRAYS_OF_TABLES.get(table)
+    system = "lines" in raw
+    cls = ((S.SYSTEM_VARIANTS.get(table) if system else None) or S.TABLES.get(table)
+           or S.ARRAYS_OF_TABLES.get(table) or S.NAMED_TABLES.get(table))
     if table == "initial":
-        cls = S.INITIAL_SHAPES.get(raw.get("initial", {}).get("shape", ""))
+        cls = _initial_shapes(raw).get(raw.get("initial", {}).get("shape", "lines" if system else ""))
     if cls is None:
         return {}
     return {f.name: (f.metadata["spec"], f.default) for f in fields(cls) if "spec" in f.metadata}
+
+
+def _initial_shapes(raw: dict) -> dict:
+    """The ``initial.shape`` choices of the scene ``raw``: a system's or one rope's."""
+    from . import schema as S
+
+    return S.SYSTEM_INITIAL_SHAPES if "lines" in raw else S.INITIAL_SHAPES
 
 
 def _doc(spec) -> str:
@@ -167,7 +176,7 @@ def annotated_copy(source: Path, name: str, label: str | None = None) -> str:
             if table is None and k == "name":
                 line, named = f'name = "{name}"', True
             if table == "initial" and k == "shape":
-                spec = S.Spec("str", "initial shape", choices=tuple(S.INITIAL_SHAPES))
+                spec = S.Spec("str", "initial shape", choices=tuple(_initial_shapes(raw)))
             if spec is not None and out[-1] != f"# {_doc(spec)}":
                 out.append(f"# {_doc(spec)}")
             seen.add(k)
