@@ -119,7 +119,7 @@ class SdirkFamily(Integrator):
         nt, m = dim * n, w * dim
         jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
         tol = NEWTON_TOL * min(line.segment_length for line in model.lines)
-        groups = model_groups(model, w) if WITH_JUNCTIONS.name in model.switches else None   # a rope's: none
+        groups = model_groups(model, w, bodies=False) if WITH_JUNCTIONS.name in model.switches else None   # a rope's: none
         self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, tol, np.zeros(nt), groups)
         shape = (dim, n)
         self.stage = Stage(*(np.zeros(shape) for _ in Stage._fields))
