@@ -28,6 +28,12 @@ of the forces on them (:func:`~ropesim.model.junctions.fold_junctions`), the ste
 and the points' unknowns by a Schur complement (:mod:`ropesim.model.schur`). The pseudo-time step starts at the
 stiffest line's spring period, and no node moves more than the shortest segment in one step.
 
+A free rigid body's unknowns are its reference point's displacement and a small rotation vector (six in 3-D,
+three in 2-D), in the same Schur complement; its orientation moves on the rotation group (q <- exp(phi) q) and
+its line ends follow it (:class:`~ropesim.model.body_groups.StaticBodies`): its own rows are its mass matrix plus
+tau^2 its rotational geometric stiffness, the merit function adds its potential energy, and its residual is its
+net force and its net moment over its size. It turns by at most MAX_TURN in one step.
+
 Drag in a flow depends on positions too, through each node's tangent (the split into normal and tangential
 drag): K_t = -dF_drag/dx (:func:`ropesim.model.forces.fluid.add_fluid_tangent_stiffness`), which the
 integrator's symmetric matrix leaves out. For a line hanging in a current it is as large as the springs'
@@ -194,7 +200,6 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
             du *= shorten
         step *= shorten
         slope = -float(step @ force)
-        drift = 0.0
         if du is not None:
             own, own_drag = bodies.rates(du)
             slope -= own
