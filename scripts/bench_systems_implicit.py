@@ -13,7 +13,9 @@ lines hanging in catenaries and swinging), N nodes in all:
 - ``spread, forward only``: the same, every line factored from its first node (the reverse factorisation off),
   to show what that choice saves;
 - ``series``: six lines in a row between two anchors, joined at five free 50 kg points (every inner line has a
-  group at both ends, the worst case: one group's columns travel its whole length).
+  group at both ends, the worst case: one group's columns travel its whole length);
+- ``spread, free body``: the spread's three lines to fairleads 1 m from the axis of a free 200 kg rigid body
+  instead of the point (its six unknowns, its Newton-Euler equations and their linearisation in the solve).
 
 Each contender runs the same number of steps, interleaved round by round (scripts/benchlib.py); the table gives
 the median wall time per node and Newton iteration, and each one's ratio to ``one line`` (median of per-round
@@ -56,6 +58,21 @@ def points_text(points: list[tuple[str, tuple, float | None]], lines: list[tuple
     return "\n".join(out)
 
 
+def body_text(anchors: list, per: int, t_end: float) -> str:
+    """The spread's lines from ``anchors`` to fairleads on a free 200 kg body (inertia 20 kg m^2 about each axis)
+    1 m from its axis, each line of ``per`` nodes."""
+    out = ['name = "body_spread"\ndimension = 3\n', WIRE,
+           '[[bodies]]\nid = "buoy"\nposition = [0.0, -30.0, 0.0]\nmass = 200.0\ninertia = [20.0, 20.0, 20.0]\n']
+    for i, (pid, position, _) in enumerate(anchors):
+        angle = 2 * math.pi * i / 3
+        out.append(f'[[points]]\nid = "{pid}"\nposition = {list(position)}\n')
+        out.append(f'[[points]]\nid = "f{i}"\nbody = "buoy"\nposition = [{math.cos(angle)!r}, 0.0, {math.sin(angle)!r}]\n')
+        out.append(f'[[lines]]\nid = "l{i}"\ntype = "wire"\nstart = "{pid}"\nend = "f{i}"\nlength = 55.0\n'
+                   f"segments = {per - 1}\n")
+    out.append(TAIL.format(t_end=t_end))
+    return "\n".join(out)
+
+
 def layouts(n: int, t_end: float) -> dict[str, str]:
     """Each layout's scene text with about ``n`` nodes in all."""
     one = points_text([("a", (0.0, 0.0, 0.0), None), ("w", (40.0, -40.0, 0.0), 200.0)],
@@ -75,7 +92,7 @@ def layouts(n: int, t_end: float) -> dict[str, str]:
 
     start = build(scene_from_toml(one)).x0.T.tolist()
     return {"rope": rope_text(n, t_end, start), "one line": one, "spread": spread, "spread, forward only": spread,
-            "series": series}
+            "series": series, "spread, free body": body_text(anchors, n // 3, t_end)}
 
 
 def stepper(name: str, text: str):

@@ -11,7 +11,11 @@ scene's initial shape, the held nodes where the scene holds them at t = 0, and r
   touchdown point, the grounded node next to the suspended part;
 - a system's figures per point and per line: each fixed and driven point's support force (the sum over its
   line ends), each free point's static position; each line's tensions at its two ends and its largest, its
-  slack segments, the length of it on the seabed and its touchdown node.
+  slack segments, the length of it on the seabed and its touchdown node;
+- each rigid body's pose (its reference point, orientation as a unit quaternion and as the scene's angles) and
+  the force and moment (about its reference point) each line puts on it: the line's end segment's tension along
+  that segment, summed over the line's ends on the body, as a run's results give it
+  (:class:`ropesim.analysis.objects.BodyResults`).
 """
 
 from __future__ import annotations
@@ -36,6 +40,21 @@ class PointFigures:
     kind: str
     position: np.ndarray        # (D,)
     force: np.ndarray | None    # (D,), None for a free point
+
+
+@dataclass(frozen=True)
+class BodyFigures:
+    """A rigid body at rest: its kind, its reference point's position [m], its orientation (a unit quaternion
+    (4,), w first, and the scene's angles [deg]), and the force [N] (D,) and moment [N m] about its reference
+    point ((3,) in 3-D, (1,) about z in 2-D) of each line with an end on it."""
+
+    id: str
+    kind: str
+    position: np.ndarray
+    quaternion: np.ndarray
+    angles: np.ndarray
+    line_forces: dict
+    line_moments: dict
 
 
 @dataclass(frozen=True)
@@ -72,6 +91,7 @@ class StaticShape:
     touchdown: int | None       # the grounded node next to the suspended rope, or None
     lines: tuple[LineFigures, ...] = ()     # every line's figures (a rope: one)
     points: tuple[PointFigures, ...] = ()   # a system's points (a rope: none)
+    bodies: tuple[BodyFigures, ...] = ()    # a system's rigid bodies (free ones at their static poses)
 
 
 def equilibrium(scene: S.Scene) -> StaticShape:
@@ -85,8 +105,39 @@ def equilibrium(scene: S.Scene) -> StaticShape:
     lines = tuple(_line_figures(model, x, line, tension[part], grounded)
                   for line, part in zip(model.lines, line_segments(model)))
     points = _point_figures(model, x, supports) if scene.is_system else ()
+    bodies = _body_figures(model, x, tension, result.pose) if scene.is_system else ()
     return StaticShape(model, x.T.copy(), result.residual, result.scale, result.iterations, result.converged,
-                       model.held_idx.copy(), supports, tension, grounded, length, touchdown, lines, points)
+                       model.held_idx.copy(), supports, tension, grounded, length, touchdown, lines, points, bodies)
+
+
+def _body_figures(model: Model, x: np.ndarray, tension: np.ndarray, pose: np.ndarray) -> tuple[BodyFigures, ...]:
+    """Each rigid body's pose (free ones at ``pose`` (7, B), the others where the scene puts them at t = 0) and
+    each line's force and moment on it (see the module doc)."""
+    from ..analysis.objects import attached_ends, end_force, moment
+    from ..analysis.rotation import angles_from_quaternion
+    from ..model.bodies import initial_pose
+
+    scene, dim = model.scene, model.dim
+    layouts = {line.id: (line, part) for line, part in zip(model.lines, line_segments(model))}
+    out, free = [], 0
+    for body in scene.rigid_bodies:
+        if body.kind == "free":
+            at, free = pose[:, free], free + 1
+        else:
+            at = initial_pose(body, dim)
+        forces, moments = {}, {}
+        for point in (p.id for p in scene.points if p.body == body.id):
+            for line_id, which in attached_ends(scene, point):
+                line, part = layouts[line_id]
+                node, neighbour, k = ((line.first, line.first + 1, part.start) if which == "start"
+                                      else (line.end - 1, line.end - 2, part.stop - 1))
+                force = end_force(x.T[None], tension[None, k], node, neighbour)[0]
+                turn = moment(x[:, node] - at[:dim], force)
+                forces[line_id] = forces.get(line_id, 0.0) + force
+                moments[line_id] = moments.get(line_id, 0.0) + turn
+        out.append(BodyFigures(body.id, body.kind, at[:dim].copy(), at[3:7].copy(),
+                               angles_from_quaternion(at[3:7], dim), forces, moments))
+    return tuple(out)
 
 
 def _line_figures(model: Model, x: np.ndarray, line, tension: np.ndarray, grounded: np.ndarray) -> LineFigures:

@@ -502,7 +502,9 @@ def equilibrium(
 
     The solve starts from the scene's initial shape (an 'equilibrium' start from its sagging guess) and balances
     weight, buoyancy, the springs, bending, the seabed's contact and drag in the flow at its full strength. A
-    scene with initial.shape = "equilibrium" starts its runs from this shape. Exit 1 if it does not converge.
+    system's free points and free rigid bodies are balanced too (a body in position and orientation, from where
+    the scene puts it): each body's pose and each line's force and moment on it are printed. A scene with
+    initial.shape = "equilibrium" starts its runs from this shape. Exit 1 if it does not converge.
     """
     from .report import equilibrium_data, print_equilibrium
     from ..analysis.statics import as_points_scene, equilibrium as solve

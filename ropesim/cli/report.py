@@ -526,6 +526,14 @@ def _system_equilibrium_rows(table, shape, axes: str) -> None:
             if line.touchdown is not None:
                 text += f", touchdown at node {line.touchdown}, {_point(shape.x[line.touchdown])} m"
         table.add_row(f"line {line.id}", text)
+    turns = "xyz" if len(axes) == 3 else "z"
+    for body in shape.bodies:
+        angles = ", ".join(f"{a:.6g}" for a in body.angles)
+        table.add_row(f"body {body.id}", f"{body.kind} at {_point(body.position)} m, turned ({angles}) deg")
+        for line, force in body.line_forces.items():
+            parts = ", ".join(f"F{a} = {f:.6g}" for a, f in zip(axes, force))
+            turn = ", ".join(f"M{a} = {m:.6g}" for a, m in zip(turns, body.line_moments[line]))
+            table.add_row("", f"line {line} on it: {parts} N; {turn} N m about its reference point")
     if shape.model.scene.seabed is not None and not shape.grounded.size:
         table.add_row("seabed", "no node touches it")
 
@@ -605,6 +613,12 @@ def equilibrium_data(shape, source: str) -> dict:
                          "largest_tension_N": line.largest, "largest_segment": line.largest_segment,
                          "slack_segments": line.slack, "grounded_length_m": line.grounded_length,
                          "touchdown_node": line.touchdown} for line in shape.lines]
+        out["bodies"] = [{"id": body.id, "kind": body.kind, "position_m": [float(c) for c in body.position],
+                          "quaternion": [float(c) for c in body.quaternion],
+                          "angles_deg": [float(c) for c in body.angles],
+                          "lines": [{"id": line, "force_N": [float(f) for f in force],
+                                     "moment_Nm": [float(m) for m in body.line_moments[line]]}
+                                    for line, force in body.line_forces.items()]} for body in shape.bodies]
     if scene.seabed is not None:
         out["seabed"] = {"grounded_nodes": [int(i) for i in shape.grounded],
                          "grounded_length_m": float(shape.grounded_length),

@@ -21,10 +21,12 @@ where springs are compressed, but to the same exact stage solution. Held nodes s
 every stage.
 
 A system of lines: each line's block is banded as a rope's, and the lines meet only at free points, whose line
-ends move as one (:mod:`ropesim.model.junctions`): a point's nodes share one unknown, its equation the sum of
-its nodes' (its residual folded onto its first node), and the matrix is solved with each line banded and the
-points' unknowns by a Schur complement (:mod:`ropesim.model.schur`), still O(N). Behind the compile-time
-switch of junctions: a rope compiles none of it.
+ends move as one (:mod:`ropesim.model.junctions`), and at free rigid bodies, whose line ends follow them: a
+point's nodes share one unknown, its equation the sum of its nodes' (its residual folded onto its first node);
+a body's unknowns are its reference point and a rotation vector, its equation its Newton-Euler equations
+(:mod:`ropesim.integrate.sdirk_bodies`). The matrix is solved with each line banded and the points' and bodies'
+unknowns by a Schur complement (:mod:`ropesim.model.schur`), still O(N). Behind the compile-time switches of
+junctions and bodies: a rope compiles none of it.
 """
 
 from __future__ import annotations
@@ -39,11 +41,14 @@ from ..model.jacobian import Jacobian, band_width
 from ..model.forces.added_mass import added_mass_times
 from ..model.junctions import (WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_junctions,
                                junction_added_mass_residual)
+from ..model.bodies import WITH_BODIES
 from ..model.schur import model_groups, schur_factor, schur_solve
-from ..model.terms import (WITH_ADDED_MASS, WITH_APPLIED, accelerations, applied_accelerations, coupling_reach,
-                           newton_matrix, solve_accelerations)
+from ..model.terms import (WITH_ADDED_MASS, WITH_APPLIED, accelerations, applied_accelerations, body_accelerations,
+                           coupling_reach, newton_matrix, solve_accelerations)
 from ..model.banded import factor, solve, woodbury
 from .base import Integrator, Method
+from .sdirk_bodies import (body_stage, end_step_bodies, guess_stage, next_stage, place_stage, stage_rows,
+                           start_step, take_back_half_bodies, take_body_update)
 from .health import BOX, DRAG, FLUID, HELD, INTERNAL, NEWTON_FAILED, OK, SEABED, due, end_step, held_power, place, power
 from ..model import jit
 
@@ -94,10 +99,11 @@ SDIRK2 = Sdirk("sdirk2", 2,
                "The stiff integrator: L-stable two-stage SDIRK (Alexander 1977), second order, stable at any "
                "time step; each stage a Newton solve with the rope's banded Jacobian (O(N)), drag implicit.")
 
-Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol", "step", "groups"])
+Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol", "step", "groups", "body"])
 """The Newton solve's matrix (:class:`~ropesim.model.jacobian.Jacobian`), Woodbury arrays, right-hand side
 (N D,), whether the loop wraps around, the tolerance [m] on the largest position update, the last update
-(N D,), and a system's groups of nodes that move as one (:class:`~ropesim.model.schur.Groups`)."""
+(N D,), a system's groups of nodes that move as one (:class:`~ropesim.model.schur.Groups`), and its free
+bodies' stage state (:class:`~ropesim.integrate.sdirk_bodies.BodyStage`); None for what a scene does not have."""
 
 Stage = namedtuple("Stage", ["xh", "vh", "X", "V", "acc", "acc_box", "tmp"])
 """A stage's known part (xh, vh), its unknowns (X, V), the accelerations there and scratch, all (D, N)."""
@@ -119,8 +125,10 @@ class SdirkFamily(Integrator):
         nt, m = dim * n, w * dim
         jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
         tol = NEWTON_TOL * min(line.segment_length for line in model.lines)
-        groups = model_groups(model, w) if WITH_JUNCTIONS.name in model.switches else None   # a rope's: none
-        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, tol, np.zeros(nt), groups)
+        grouped = {WITH_JUNCTIONS.name, WITH_BODIES.name} & model.switches
+        groups = model_groups(model, w) if grouped else None   # a rope's: none
+        body = body_stage(model, groups) if WITH_BODIES.name in model.switches else None
+        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, tol, np.zeros(nt), groups, body)
         shape = (dim, n)
         self.stage = Stage(*(np.zeros(shape) for _ in Stage._fields))
         self.nodes = Nodes(np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag))
@@ -141,10 +149,12 @@ class SdirkFamily(Integrator):
 
 
 @jit.kernel
-def stage_residual(stage, rhs, beta, t_stage, held, nodes, params):
-    """At the stage's positions X, with V = (X - xh) / beta (held nodes: their own velocity), write minus the
-    residual of m (V - vh) = beta (a(X, V) m - b V) (plus A_i (V - vh) with added mass), times beta, into
-    ``rhs``. Returns (its squared norm, fluid, internal-damping and seabed power [W])."""
+def stage_residual(stage, rhs, beta, t_stage, held, nodes, params, body, groups):
+    """At the stage's positions X, with V = (X - xh) / beta (held nodes: their own velocity; a free body's line
+    ends where its stage pose puts them), write minus the residual of m (V - vh) = beta (a(X, V) m - b V) (plus
+    A_i (V - vh) with added mass), times beta, into ``rhs`` (a body's: its own, into its group's, see
+    :mod:`ropesim.integrate.sdirk_bodies`). Returns (its squared norm, fluid, internal-damping and seabed power
+    [W])."""
     xh, vh, X, V, acc = stage.xh, stage.vh, stage.X, stage.V, stage.acc
     held_idx, held_v = held.idx, held.v
     free, mass, drag = nodes
@@ -155,6 +165,8 @@ def stage_residual(stage, rhs, beta, t_stage, held, nodes, params):
     for j in range(held_idx.shape[0]):
         for d in range(dim):
             V[d, held_idx[j]] = held_v[d, j]
+    if WITH_BODIES:
+        place_stage(body, X, V, beta, params.bodies, groups.arm)
     fluid, internal, seabed = accelerations(X, V, acc, params, t_stage)
     for i in range(n):
         for d in range(dim):
@@ -177,6 +189,8 @@ def stage_residual(stage, rhs, beta, t_stage, held, nodes, params):
             junction_added_mass_residual(X, xh, vh, beta, rhs, params.junctions, params.neighbours)
         fold_junctions(rhs, params.junctions, dim)
     norm = 0.0
+    if WITH_BODIES:
+        norm += stage_rows(body, X, acc, beta, t_stage, params, groups, rhs)
     for u in range(rhs.shape[0]):
         norm += rhs[u] * rhs[u]
     return norm, fluid, internal, seabed
@@ -223,25 +237,30 @@ def solve_stage(stage, newton, beta, t_stage, t_piece, held, nodes, params):
     for d in range(dim):
         for i in range(n):
             X[d, i] = xh[d, i] + beta * vh[d, i]
+    if WITH_BODIES:
+        guess_stage(newton.body, beta)
     place(X, V, held, t_stage, t_piece)   # a path: the step's piece (t_piece its middle)
     worst_node = -1
     last = np.inf            # the residual's norm before the last update
     stride = 0.0             # the last update's largest component [m]
     halvings = 0
     for it in range(NEWTON_MAX_ITER):
-        norm, fluid, internal, seabed = stage_residual(stage, rhs, beta, t_stage, held, nodes, params)
+        norm, fluid, internal, seabed = stage_residual(stage, rhs, beta, t_stage, held, nodes, params, newton.body,
+                                                       newton.groups)
         if norm > last and stride > BACKTRACK_ABOVE * newton.tol and halvings < MAX_HALVINGS:
             # the full step made the residual worse (a contact switching on, friction reversing): go back half
             # of it and look again; a smooth problem never gets here, so its iterates are Newton's own
             halvings += 1
             stride *= 0.5
             take_back_half(X, newton.step)
+            if WITH_BODIES:
+                take_back_half_bodies(newton.body)
             continue
         last = norm
         halvings = 0
         newton_matrix(X, V, newton.jac, beta, nodes, params, t_stage)
-        if WITH_JUNCTIONS:   # each line banded, the points' unknowns by a Schur complement
-            if WITH_ADDED_MASS:
+        if WITH_JUNCTIONS or WITH_BODIES:   # each line banded, the points' and bodies' unknowns by a Schur complement
+            if WITH_JUNCTIONS and WITH_ADDED_MASS:
                 add_junction_added_mass_jacobian(X, band, params.junctions, params.neighbours)
             if not schur_factor(band, newton.jac.w, params.lines, newton.groups):
                 return -1, 0, 0.0, 0.0, 0.0
@@ -251,11 +270,15 @@ def solve_stage(stage, newton, beta, t_stage, t_piece, held, nodes, params):
                 return -1, 0, 0.0, 0.0, 0.0
             solve(band, newton.jac.corner, newton.cyclic, p, rhs, newton.wood)
         stride, worst_node = take_update(X, rhs, newton.step)
+        if WITH_BODIES:
+            stride = max(stride, take_body_update(newton.body, newton.groups))
         if stride <= newton.tol:
             for d in range(dim):
                 for i in range(n):
                     if free[i]:
                         V[d, i] = (X[d, i] - xh[d, i]) / beta
+            if WITH_BODIES:
+                place_stage(newton.body, X, V, beta, params.bodies, newton.groups.arm)
             return it + 1, -1, fluid, internal, seabed
     return -1, worst_node, 0.0, 0.0, 0.0
 
@@ -281,6 +304,8 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
             for i in range(n):
                 xh[d, i] = x[d, i]
                 vh[d, i] = v[d, i]
+        if WITH_BODIES:
+            start_step(newton.body, bodies.pose, bodies.twist)
         for k in range(2):
             t_stage = t + (GAMMA if k == 0 else 1.0) * h
             its, node, fluid, internal, seabed = solve_stage(stage, newton, beta, t_stage, t + 0.5 * h, held, nodes,
@@ -300,6 +325,9 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
                     for i in range(n):
                         tmp[d, i] = acc[d, i] - drag[i] * V[d, i] / mass[i]
                 fluid += solve_accelerations(X, V, tmp, params)
+            if WITH_BODIES:   # the fluid's forces on the bodies (drag, added mass) at the stage
+                fluid += body_accelerations(X, V, acc, params, newton.body.pose, newton.body.twist, newton.body.out,
+                                            t_stage)
             ledger[FLUID] += weight * fluid
             ledger[INTERNAL] += weight * internal
             ledger[SEABED] += weight * seabed
@@ -312,10 +340,14 @@ def advance_sdirk(state, stage, newton, held, nodes, params, limits, schedule, f
                     for i in range(n):
                         xh[d, i] = x[d, i] + (1.0 - GAMMA) * h * V[d, i]
                         vh[d, i] = v[d, i] + ratio * (V[d, i] - v[d, i])
+                if WITH_BODIES:
+                    next_stage(newton.body, bodies.twist, h, GAMMA)
         for d in range(dim):
             for i in range(n):
                 x[d, i] = X[d, i]
                 v[d, i] = V[d, i]
+        if WITH_BODIES:
+            end_step_bodies(newton.body, bodies.pose, bodies.twist)
         place(x, v, held, (step + 1) * h, (step + 1) * h)
         done = step + 1
         if not due(done, schedule):

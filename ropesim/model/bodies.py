@@ -280,11 +280,118 @@ def _solve(work, planar):
         work[2, 6] = work[3, 6] = work[4, 6] = 0.0
 
 
+@jit.kernel(inline="always")
+def body_own_system(work, gravity, flow, bodies, pose, twist, b, t, power):
+    """Body b's own part of its Newton-Euler equations (see the module doc) into ``work`` (6, 7), zeroed first:
+    its mass at its centre of gravity, inertia and added mass (the matrix), its weight, centripetal force,
+    gyroscopic moment, buoyancy and drag (the right-hand side); returns ``power`` [W] plus the drag's."""
+    r = matrix_of(pose[3:7], b)
+    w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
+    v0, v1, v2 = twist[0, b], twist[1, b], twist[2, b]
+    for i in range(6):
+        for j in range(7):
+            work[i, j] = 0.0
+    # the body's own mass at its centre of gravity, its inertia and added mass
+    m = bodies.mass[b]
+    c0, c1, c2 = rotate(r, bodies.cog[0, b], bodies.cog[1, b], bodies.cog[2, b])
+    _add_mass_at(work, m, 0.0, 0.0, m, 0.0, m, c0, c1, c2)
+    for i in range(3):   # R I_b R^T
+        for j in range(3):
+            s = 0.0
+            for k in range(3):
+                for l in range(3):
+                    s += r[3 * i + k] * bodies.inertia[k, l, b] * r[3 * j + l]
+            work[3 + i, 3 + j] += s
+    _add_rotated(work, 0, 0, r, bodies.added[0, b], bodies.added[1, b], bodies.added[2, b])
+    _add_rotated(work, 3, 3, r, bodies.added_rot[0, b], bodies.added_rot[1, b], bodies.added_rot[2, b])
+    # its weight and centripetal force at c, the gyroscopic moment w x (I w), buoyancy at its centre of buoyancy
+    e0, e1, e2 = cross(w0, w1, w2, c0, c1, c2)
+    n0, n1, n2 = cross(w0, w1, w2, e0, e1, e2)   # w x (w x c)
+    f0, f1, f2 = -m * n0, -m * n1 - m * gravity, -m * n2
+    wb = rotate_back(r, w0, w1, w2)
+    j0 = j1 = j2 = 0.0   # I_b (R^T w)
+    for l in range(3):
+        j0 += bodies.inertia[0, l, b] * wb[l]
+        j1 += bodies.inertia[1, l, b] * wb[l]
+        j2 += bodies.inertia[2, l, b] * wb[l]
+    i0, i1, i2 = rotate(r, j0, j1, j2)   # (R I_b R^T) w
+    g0, g1, g2 = cross(w0, w1, w2, i0, i1, i2)
+    m0, m1, m2 = cross(c0, c1, c2, f0, f1, f2)
+    work[0, 6] += f0
+    work[1, 6] += f1
+    work[2, 6] += f2
+    work[3, 6] += m0 - g0
+    work[4, 6] += m1 - g1
+    work[5, 6] += m2 - g2
+    lift = bodies.lift[b]
+    if lift != 0.0:
+        k0, _, k2 = rotate(r, bodies.cob[0, b], bodies.cob[1, b], bodies.cob[2, b])
+        work[1, 6] += lift
+        work[3, 6] -= k2 * lift   # (k x lift y)_x = -k_z lift
+        work[5, 6] += k0 * lift
+    # drag on the flow relative to the reference point, in body axes
+    u0, u1, u2 = -v0, -v1, -v2
+    if WITH_FLOW:
+        U0, U1, U2 = flow_at(pose[1, b], t, flow[0], flow[1])
+        u0 += U0
+        u1 += U1
+        u2 += U2
+    speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+    spin = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+    ub = rotate_back(r, u0, u1, u2)
+    for k in range(3):
+        fb = bodies.drag[k, b] * speed * ub[k]
+        tb = -bodies.drag_rot[k, b] * spin * wb[k]
+        for i in range(3):
+            work[i, 6] += r[3 * i + k] * fb
+            work[3 + i, 6] += r[3 * i + k] * tb
+            power += r[3 * i + k] * (fb * twist[i, b] + tb * twist[3 + i, b])
+    return power
+
+
+@jit.kernel(inline="always")
+def body_attachments_system(work, x, acc, inv_mass, around, bodies, pose, twist, b):
+    """Add body b's attachments to its Newton-Euler equations in ``work`` (6, 7): each node's mass and added
+    mass at its arm, and its force m_i acc_i less its centripetal part (``acc`` holding each node's F_i / m_i)."""
+    dim = x.shape[0]
+    start, nodes, arm, node_added = bodies.start, bodies.nodes, bodies.arm, bodies.node_added
+    r = matrix_of(pose[3:7], b)
+    w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
+    for k in range(start[b], start[b + 1]):
+        i = nodes[k]
+        p0, p1, p2 = rotate(r, arm[0, k], arm[1, k], arm[2, k])
+        mi = 1.0 / inv_mass[i]
+        a_n, a_t = node_added[0, k], node_added[1, k]
+        q0, q1, q2 = node_tangent(x, i, around)
+        extra = a_t - a_n   # m I + a_n (I - q q^T) + a_t q q^T
+        m00 = mi + a_n + extra * q0 * q0
+        m01 = extra * q0 * q1
+        m02 = extra * q0 * q2
+        m11 = mi + a_n + extra * q1 * q1
+        m12 = extra * q1 * q2
+        m22 = mi + a_n + extra * q2 * q2
+        _add_mass_at(work, m00, m01, m02, m11, m12, m22, p0, p1, p2)
+        e0, e1, e2 = cross(w0, w1, w2, p0, p1, p2)
+        n0, n1, n2 = cross(w0, w1, w2, e0, e1, e2)   # w x (w x rho)
+        g0 = mi * acc[0, i] - (m00 * n0 + m01 * n1 + m02 * n2)
+        g1 = mi * acc[1, i] - (m01 * n0 + m11 * n1 + m12 * n2)
+        g2 = (mi * acc[2, i] if dim == 3 else 0.0) - (m02 * n0 + m12 * n1 + m22 * n2)
+        m0, m1, m2 = cross(p0, p1, p2, g0, g1, g2)
+        work[0, 6] += g0
+        work[1, 6] += g1
+        work[2, 6] += g2
+        work[3, 6] += m0
+        work[4, 6] += m1
+        work[5, 6] += m2
+
+
 @jit.kernel
 def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist, out, t):
     """The free bodies' accelerations (see the module doc) into ``out`` (6, B) (a, then alpha), from ``acc``
     holding each attachment node's F_i / m_i, and every attachment's acceleration a + alpha x rho + w x (w x rho)
-    into ``acc``; returns the power [W] of the fluid's forces on the bodies (drag and added mass)."""
+    into ``acc``; returns the power [W] of the fluid's forces on the bodies (drag and added mass). The equations
+    are assembled by :func:`body_own_system` and :func:`body_attachments_system` (which the stiff integrator's
+    Newton solve takes as its residual, :mod:`ropesim.model.body_newton`)."""
     dim = x.shape[0]
     work = bodies.work
     start, nodes, arm, node_added = bodies.start, bodies.nodes, bodies.arm, bodies.node_added
@@ -293,91 +400,9 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
         r = matrix_of(pose[3:7], b)
         w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
         v0, v1, v2 = twist[0, b], twist[1, b], twist[2, b]
-        for i in range(6):
-            for j in range(7):
-                work[i, j] = 0.0
-        # the body's own mass at its centre of gravity, its inertia and added mass
-        m = bodies.mass[b]
-        c0, c1, c2 = rotate(r, bodies.cog[0, b], bodies.cog[1, b], bodies.cog[2, b])
-        _add_mass_at(work, m, 0.0, 0.0, m, 0.0, m, c0, c1, c2)
-        for i in range(3):   # R I_b R^T
-            for j in range(3):
-                s = 0.0
-                for k in range(3):
-                    for l in range(3):
-                        s += r[3 * i + k] * bodies.inertia[k, l, b] * r[3 * j + l]
-                work[3 + i, 3 + j] += s
-        _add_rotated(work, 0, 0, r, bodies.added[0, b], bodies.added[1, b], bodies.added[2, b])
-        _add_rotated(work, 3, 3, r, bodies.added_rot[0, b], bodies.added_rot[1, b], bodies.added_rot[2, b])
-        # its weight and centripetal force at c, the gyroscopic moment w x (I w), buoyancy at its centre of buoyancy
-        e0, e1, e2 = cross(w0, w1, w2, c0, c1, c2)
-        n0, n1, n2 = cross(w0, w1, w2, e0, e1, e2)   # w x (w x c)
-        f0, f1, f2 = -m * n0, -m * n1 - m * gravity, -m * n2
+        power = body_own_system(work, gravity, flow, bodies, pose, twist, b, t, power)
         wb = rotate_back(r, w0, w1, w2)
-        j0 = j1 = j2 = 0.0   # I_b (R^T w)
-        for l in range(3):
-            j0 += bodies.inertia[0, l, b] * wb[l]
-            j1 += bodies.inertia[1, l, b] * wb[l]
-            j2 += bodies.inertia[2, l, b] * wb[l]
-        i0, i1, i2 = rotate(r, j0, j1, j2)   # (R I_b R^T) w
-        g0, g1, g2 = cross(w0, w1, w2, i0, i1, i2)
-        m0, m1, m2 = cross(c0, c1, c2, f0, f1, f2)
-        work[0, 6] += f0
-        work[1, 6] += f1
-        work[2, 6] += f2
-        work[3, 6] += m0 - g0
-        work[4, 6] += m1 - g1
-        work[5, 6] += m2 - g2
-        lift = bodies.lift[b]
-        if lift != 0.0:
-            k0, _, k2 = rotate(r, bodies.cob[0, b], bodies.cob[1, b], bodies.cob[2, b])
-            work[1, 6] += lift
-            work[3, 6] -= k2 * lift   # (k x lift y)_x = -k_z lift
-            work[5, 6] += k0 * lift
-        # drag on the flow relative to the reference point, in body axes
-        u0, u1, u2 = -v0, -v1, -v2
-        if WITH_FLOW:
-            U0, U1, U2 = flow_at(pose[1, b], t, flow[0], flow[1])
-            u0 += U0
-            u1 += U1
-            u2 += U2
-        speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
-        spin = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
-        ub = rotate_back(r, u0, u1, u2)
-        for k in range(3):
-            fb = bodies.drag[k, b] * speed * ub[k]
-            tb = -bodies.drag_rot[k, b] * spin * wb[k]
-            for i in range(3):
-                work[i, 6] += r[3 * i + k] * fb
-                work[3 + i, 6] += r[3 * i + k] * tb
-                power += r[3 * i + k] * (fb * twist[i, b] + tb * twist[3 + i, b])
-        # the attachments: their forces, masses and added masses at their arms
-        for k in range(start[b], start[b + 1]):
-            i = nodes[k]
-            p0, p1, p2 = rotate(r, arm[0, k], arm[1, k], arm[2, k])
-            mi = 1.0 / inv_mass[i]
-            a_n, a_t = node_added[0, k], node_added[1, k]
-            q0, q1, q2 = node_tangent(x, i, around)
-            extra = a_t - a_n   # m I + a_n (I - q q^T) + a_t q q^T
-            m00 = mi + a_n + extra * q0 * q0
-            m01 = extra * q0 * q1
-            m02 = extra * q0 * q2
-            m11 = mi + a_n + extra * q1 * q1
-            m12 = extra * q1 * q2
-            m22 = mi + a_n + extra * q2 * q2
-            _add_mass_at(work, m00, m01, m02, m11, m12, m22, p0, p1, p2)
-            e0, e1, e2 = cross(w0, w1, w2, p0, p1, p2)
-            n0, n1, n2 = cross(w0, w1, w2, e0, e1, e2)   # w x (w x rho)
-            g0 = mi * acc[0, i] - (m00 * n0 + m01 * n1 + m02 * n2)
-            g1 = mi * acc[1, i] - (m01 * n0 + m11 * n1 + m12 * n2)
-            g2 = (mi * acc[2, i] if dim == 3 else 0.0) - (m02 * n0 + m12 * n1 + m22 * n2)
-            m0, m1, m2 = cross(p0, p1, p2, g0, g1, g2)
-            work[0, 6] += g0
-            work[1, 6] += g1
-            work[2, 6] += g2
-            work[3, 6] += m0
-            work[4, 6] += m1
-            work[5, 6] += m2
+        body_attachments_system(work, x, acc, inv_mass, around, bodies, pose, twist, b)
         _solve(work, dim == 2)
         a0, a1, a2, al0, al1, al2 = work[0, 6], work[1, 6], work[2, 6], work[3, 6], work[4, 6], work[5, 6]
         for d in range(6):

@@ -133,6 +133,7 @@ def build(scene: S.Scene, solve: bool = True) -> Model:
                                    f"(largest residual force {result.residual:.3g} N after {result.iterations} "
                                    f"iterations); start from another shape")
         model.x0[:] = result.x
+        model.body_pose0[:] = result.pose
     return model
 
 

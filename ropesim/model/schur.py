@@ -362,14 +362,24 @@ def schur_solve(band, w, lines, groups, rhs):
             rhs[c * dim + b] = val
 
 
-def model_groups(model, w: int) -> Groups:
+def model_groups(model, w: int, bodies: bool = True) -> Groups:
     """The groups of ``model``'s Newton matrix (block half-width ``w``): its free points where lines meet
-    (:class:`~ropesim.model.junctions.Junctions`); the empty bundle for a rope."""
-    junctions = model.params.junctions
-    if junctions is None:
-        return no_groups(model.dim)
-    members = [(model.dim, [int(i) for i in junctions.nodes[a:b]], None)
-               for a, b in zip(junctions.start[:-1], junctions.start[1:])]
+    (:class:`~ropesim.model.junctions.Junctions`), then (with ``bodies``) its free rigid bodies, their arms at their
+    initial poses (:mod:`ropesim.model.body_groups`); the empty bundle for a rope."""
+    from .body_groups import body_unknowns, set_body_arms
+
+    junctions, free = model.params.junctions, model.params.bodies if bodies else None
+    members = []
+    if junctions is not None:
+        members += [(model.dim, [int(i) for i in junctions.nodes[a:b]], None)
+                    for a, b in zip(junctions.start[:-1], junctions.start[1:])]
+    first = sum(len(nodes) for _, nodes, _ in members)
+    if free is not None:
+        members += [(body_unknowns(model.dim), [int(i) for i in free.nodes[a:b]], None)
+                    for a, b in zip(free.start[:-1], free.start[1:])]
     if not members:
         return no_groups(model.dim)
-    return groups_of(model.lines, members, model.dim, w, model.nodes)
+    groups = groups_of(model.lines, members, model.dim, w, model.nodes)
+    if free is not None:
+        set_body_arms(groups.arm, first, free, model.body_pose0)
+    return groups

@@ -28,6 +28,12 @@ of the forces on them (:func:`~ropesim.model.junctions.fold_junctions`), the ste
 and the points' unknowns by a Schur complement (:mod:`ropesim.model.schur`). The pseudo-time step starts at the
 stiffest line's spring period, and no node moves more than the shortest segment in one step.
 
+A free rigid body's unknowns are its reference point's displacement and a small rotation vector (six in 3-D,
+three in 2-D), in the same Schur complement; its orientation moves on the rotation group (q <- exp(phi) q) and
+its line ends follow it (:class:`~ropesim.model.body_groups.StaticBodies`): its own rows are its mass matrix plus
+tau^2 its rotational geometric stiffness, the merit function adds its potential energy, and its residual is its
+net force and its net moment over its size. It turns by at most MAX_TURN in one step.
+
 Drag in a flow depends on positions too, through each node's tangent (the split into normal and tangential
 drag): K_t = -dF_drag/dx (:func:`ropesim.model.forces.fluid.add_fluid_tangent_stiffness`), which the
 integrator's symmetric matrix leaves out. For a line hanging in a current it is as large as the springs'
@@ -44,7 +50,7 @@ puts on a node (its weight, or its spring's pull at 1 % strain), by default 1e-1
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -54,6 +60,7 @@ from .banded import woodbury
 from .jacobian import Jacobian, band_width
 from .forces.fluid import WITH_FLUID_DRAG, WITH_VISCOUS_DRAG, add_fluid_tangent_stiffness
 from .junctions import WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_junctions
+from .body_groups import StaticBodies
 from .schur import model_groups, schur_factor, schur_solve
 from .terms import accelerations, coupling_reach, mechanical_energy, newton_matrix, velocity_accelerations
 from . import jit
@@ -62,17 +69,20 @@ TOL = 1e-10
 MAX_ITERATIONS = 2000
 KRYLOV_TOL = 1e-10        # GMRES stops when the step's linear residual is this fraction of tau^2 |F|
 KRYLOV_DIMENSION = 80     # ... or after this many Krylov vectors (the step is then inexact; the search judges it)
+MAX_TURN = 0.25          # a free body turns by at most this many radians in one step
 
 
 @dataclass(frozen=True)
 class Equilibrium:
-    """The static shape (D, N) [m], the largest residual force [N] and what it is relative to, iterations."""
+    """The static shape (D, N) [m], the largest residual force [N] and what it is relative to, iterations; the
+    free bodies' poses (7, B) (reference point, unit quaternion)."""
 
     x: np.ndarray
     residual: float
     scale: float
     iterations: int
     converged: bool
+    pose: np.ndarray = field(default_factory=lambda: np.zeros((7, 0)))
 
 
 @jit.kernel
@@ -95,9 +105,11 @@ def forces_on_free_nodes(x, v, acc, p, t, mass, free, out):
 
 
 def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
-                      max_iterations: int = MAX_ITERATIONS) -> Equilibrium:
-    """The static shape of ``model`` from the guess ``x`` (D, N) (default: its initial positions)."""
+                      max_iterations: int = MAX_ITERATIONS, pose: np.ndarray | None = None) -> Equilibrium:
+    """The static shape of ``model`` from the guess ``x`` (D, N) (default: its initial positions) and the free
+    bodies' poses ``pose`` (7, B) (default: their initial poses)."""
     x = np.array(model.x0 if x is None else x, dtype=float)
+    pose = np.array(model.body_pose0 if pose is None else pose, dtype=float)
     dim, n = x.shape
     scene, p = model.scene, model.params
     static_force, nonconservative, energy_of, jacobian, tangent_stiffness, factor, solve = (model.kernel(f) for f in (
@@ -113,16 +125,23 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
     wood = woodbury(nt, m)
     groups = model_groups(model, w)
-    if groups.nodes.size:   # a system's free points: each line banded, the points by a Schur complement
+    bodies = StaticBodies(model, groups, t) if p.bodies is not None else None
+    junctions = p.junctions
+    if groups.nodes.size:   # a system's free points and bodies: each line banded, they by a Schur complement
         def factored() -> bool:
-            add_junction_added_mass_jacobian(x, jac.band, p.junctions, p.neighbours)
+            if junctions is not None:
+                add_junction_added_mass_jacobian(x, jac.band, junctions, p.neighbours)
+            if bodies is not None:
+                bodies.fill(tau)
             return schur_factor(jac.band, w, p.lines, groups)
 
-        def inverse(z: np.ndarray) -> None:
+        def inverse(z: np.ndarray) -> np.ndarray | None:
             schur_solve(jac.band, w, p.lines, groups, z)
+            return bodies.step() if bodies is not None else None   # the bodies' unknowns
 
         def folded(z: np.ndarray) -> np.ndarray:
-            fold_junctions(z, p.junctions, dim)
+            if junctions is not None:
+                fold_junctions(z, junctions, dim)
             return z
     else:
         def factored() -> bool:
@@ -133,12 +152,26 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
 
         def folded(z: np.ndarray) -> np.ndarray:
             return z
+
+    def balance(x: np.ndarray, pose: np.ndarray, out: np.ndarray) -> tuple[float, float, float]:
+        """The net forces into ``out``; (the largest left on a free node or body, the residual's norm [N], the
+        potential energy [J]). A body's line ends carry their lines' pull: its residual is its net force and
+        moment (over its size)."""
+        if bodies is not None:
+            bodies.place(x, pose)
+        worst = static_force(x, v, acc, p, t, mass, free, out)
+        energy = float(energy_of(x, v, mass, p)[0])
+        if bodies is None:
+            return worst, float(np.linalg.norm(out)), energy
+        bodies.evaluate(pose, out)
+        loose = out.reshape(n, dim)[~bodies.attached]
+        worst = max(float(np.abs(loose).max(initial=0.0)) if np.all(np.isfinite(loose)) else np.inf, bodies.worst())
+        return worst, math.hypot(float(np.linalg.norm(loose)), bodies.norm()), energy + bodies.energy(pose)
+
     nodes = (free, mass, np.where(model.held, 0.0, model.drag))
     force, trial, other = np.zeros(nt), np.zeros(nt), np.zeros(nt)
     scale = _force_scale(model)
-    worst = static_force(x, v, acc, p, t, mass, free, force)
-    norm = float(np.linalg.norm(force))
-    energy = float(energy_of(x, v, mass, p)[0])
+    worst, norm, energy = balance(x, pose, force)
     stiffest = max(line.stiffness for line in model.lines)
     tau = math.sqrt(float(mass[free].min()) / max(stiffest, 1e-300))   # one spring's period
     reach = min(line.segment_length for line in model.lines)
@@ -146,7 +179,7 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     blocks = np.zeros((n, 3, dim, dim)) if dragged else None
     for iteration in range(1, max_iterations + 1):
         if worst <= tol * scale:
-            return Equilibrium(x, worst, scale, iteration - 1, True)
+            return Equilibrium(x, worst, scale, iteration - 1, True, pose)
         jacobian(x, v, jac, tau, nodes, p, t)   # M + tau b + tau^2 K + tau C, so the step is tau^2 F
         if not factored():
             tau *= 0.25
@@ -156,26 +189,32 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
             blocks[:] = 0.0
             tangent_stiffness(x, v, blocks, free, p, t)
         if blocks is None or not blocks.any():
-            inverse(step)
+            du = inverse(step)
         else:
-            step = _krylov_step(step, inverse, lambda z: tau * tau * folded(_apply_blocks(blocks, z, free)))
+            step, du = _krylov_step(step, inverse, lambda z: tau * tau * folded(_apply_blocks(blocks, z, free)))
         largest = float(np.abs(step).max())
-        if largest > reach:
-            step *= reach / largest
+        shorten = reach / largest if largest > reach else 1.0
+        if du is not None:     # a body turns by at most MAX_TURN in one step
+            turns = np.abs(du[:, dim:]).max(initial=0.0)
+            shorten = min(shorten, MAX_TURN / turns if turns > MAX_TURN else 1.0)
+            du *= shorten
+        step *= shorten
         slope = -float(step @ force)
+        if du is not None:
+            own, own_drag = bodies.rates(du)
+            slope -= own
         if not slope < 0.0:          # not downhill (a non-conservative force turned it): a shorter pseudo-step
             tau *= 0.25
             if tau < 1e-30:
                 break
             continue
         nonconservative(x, v, acc, p, t, mass, free, other)
-        drift = float(step @ other)
+        drift = float(step @ other) + (own_drag if du is not None else 0.0)
         fraction, accepted = 1.0, False
         while fraction > 1e-6:
             candidate = x + fraction * step.reshape(n, dim).T
-            trial_energy = float(energy_of(candidate, v, mass, p)[0])
-            better = static_force(candidate, v, acc, p, t, mass, free, trial)
-            new_norm = float(np.linalg.norm(trial))
+            moved = bodies.moved(pose, du, fraction) if du is not None else pose
+            better, new_norm, trial_energy = balance(candidate, moved, trial)
             change = trial_energy - energy - fraction * drift
             if change <= 1e-4 * fraction * slope or (
                     abs(change) <= 1e-12 * max(abs(energy), 1.0) and new_norm <= 0.5 * norm):
@@ -186,11 +225,15 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
             tau *= 0.25
             if tau < 1e-30:
                 break
+            if bodies is not None:
+                balance(x, pose, force)   # the bodies' figures back at x
             continue
         if fraction == 1.0:
             tau = min(2.0 * tau, 1e12)
-        x, worst, norm, force, trial, energy = candidate, better, new_norm, trial, force, trial_energy
-    return Equilibrium(x, worst, scale, max_iterations, worst <= tol * scale)
+        x, pose, worst, norm, force, trial, energy = candidate, moved, better, new_norm, trial, force, trial_energy
+    if bodies is not None:
+        bodies.place(x, pose)
+    return Equilibrium(x, worst, scale, max_iterations, worst <= tol * scale, pose)
 
 
 def _apply_blocks(blocks: np.ndarray, z: np.ndarray, free: np.ndarray) -> np.ndarray:
@@ -204,19 +247,19 @@ def _apply_blocks(blocks: np.ndarray, z: np.ndarray, free: np.ndarray) -> np.nda
     return out.reshape(-1)
 
 
-def _krylov_step(rhs: np.ndarray, inverse, extra) -> np.ndarray:
+def _krylov_step(rhs: np.ndarray, inverse, extra) -> tuple[np.ndarray, np.ndarray | None]:
     """Solve (A + E) d = rhs by GMRES, right-preconditioned by A: ``inverse(z)`` overwrites z with A^-1 z (the
-    factored banded matrix), ``extra(z)`` returns E z. From d = 0; stops at KRYLOV_TOL or KRYLOV_DIMENSION
-    vectors, returning the best d so far."""
+    factored banded matrix) and returns the free bodies' unknowns of it (or None), ``extra(z)`` returns E z. From
+    d = 0; stops at KRYLOV_TOL or KRYLOV_DIMENSION vectors, returning the best d so far and its bodies' unknowns."""
     beta = float(np.linalg.norm(rhs))
     if beta == 0.0:
-        return np.zeros_like(rhs)
-    basis, preconditioned = [rhs / beta], []
+        return np.zeros_like(rhs), None
+    basis, preconditioned, unknowns = [rhs / beta], [], []
     hessenberg = np.zeros((KRYLOV_DIMENSION + 1, KRYLOV_DIMENSION))
     coefficients = np.zeros(1)
     for k in range(KRYLOV_DIMENSION):
         z = basis[k].copy()
-        inverse(z)
+        unknowns.append(inverse(z))
         preconditioned.append(z)
         w = basis[k] + extra(z)                  # (A + E) A^-1 v
         for _ in range(2):                       # Gram-Schmidt twice: orthogonal to round-off
@@ -232,7 +275,10 @@ def _krylov_step(rhs: np.ndarray, inverse, extra) -> np.ndarray:
         if residual <= KRYLOV_TOL * beta or hessenberg[k + 1, k] <= 1e-300:
             break
         basis.append(w / hessenberg[k + 1, k])
-    return sum(c * z for c, z in zip(coefficients, preconditioned))
+    step = sum(c * z for c, z in zip(coefficients, preconditioned))
+    if unknowns[0] is None:
+        return step, None
+    return step, sum(c * u for c, u in zip(coefficients, unknowns))
 
 
 @jit.kernel

@@ -1,0 +1,314 @@
+"""Free rigid bodies in the stiff integrator's Newton solve (:mod:`ropesim.integrate.sdirk`).
+
+A body's stage unknowns are its reference point r and a rotation vector phi from its orientation at the step's
+start, q = exp(phi) q_n (so q is a unit quaternion to round-off whatever the Newton iterates do); its stage
+twist W = (v, w) follows from them as the nodes' velocities do from their positions, W = (U - U_hat) / beta,
+U = (r, phi). SDIRK2 is applied to (U, W) as to (x, v), with U' = W: the Runge-Kutta-Munthe-Kaas method with
+dexp^-1_phi truncated to the identity, which keeps the order of a method of order 2 (its error, phi x w / 2 with
+phi = t w + O(t^2), enters the step at O(h^3)). The body's line ends (its attachments) sit where the stage pose
+puts them and move at v + w x rho (:func:`place_stage`).
+
+The body's equation at a stage is its Newton-Euler equations (:mod:`ropesim.model.bodies`) in the nodes' form,
+
+    R_b = -beta [M (W - W_hat) - beta F],
+
+M its 6 x 6 mass matrix about the reference point (its own mass, inertia and added mass, its attachments' masses
+and added masses at their arms) and F the right-hand side of ``move_bodies`` (its own forces and moments, its
+attachments' forces, less the centripetal forces and the gyroscopic moment). It is the group's own residual in
+the Schur complement (:mod:`ropesim.model.schur`); its attachments' rows hold nothing of their own (their
+forces are in F). The Newton matrix's group block is then G^T J G over the attachments (the band: their masses,
+the springs' stiffness beta^2 K and damping beta C at them, coupled to their lines through B) plus the body's own
+block (:func:`stage_rows`):
+
+    O = M - sum_c m_c G_c^T G_c (the plain masses the band already holds) + beta^2 K_phi + beta D,
+
+K_phi = -sum [F]x [p]x the rotational geometric stiffness of the forces that turn with the body (its weight at
+its centre of gravity, its buoyancy at its centre of buoyancy, each attachment's force at its arm; see
+:mod:`ropesim.model.body_groups`), and D = -dF/dW: the gyroscopic moment's [w]x I - [I w]x, the centripetal
+forces' -M_p ([w x p]x + [w]x [p]x) at each mass's arm p, and the drag's and rotational drag's
+R diag(d) (|u| I + u u^T / |u|) R^T. Left out: the dependence of the centripetal and drag terms on the
+orientation (O(beta^2 w^2)), which only slows Newton's convergence, never changes its solution.
+
+Stored in :class:`BodyStage`; everything here runs behind the bodies switch.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+
+from ..model import jit
+from ..model.bodies import _add_mass_at, body_attachments_system, body_own_system, place_attachments
+from ..model.body_groups import body_unknowns, kept_rows, set_body_arms
+from ..model.forces.fluid import WITH_FLOW, flow_at, node_tangent
+from ..model.forces.gravity import WITH_GRAVITY
+from ..model.rotation import cross, matrix_of, rotate_back, turn
+
+BodyStage = namedtuple("BodyStage", ["base", "pose", "twist", "hat_r", "hat_phi", "hat_w", "r", "phi", "step",
+                                     "work", "own", "inertia", "out", "keep", "where"])
+"""A stage's body state (B free bodies): base (7, B) the poses at the step's start; pose (7, B) and twist (6, B)
+the stage's; hat_r, hat_phi (3, B) and hat_w (6, B) the stage's known parts; r, phi (3, B) its unknowns; step
+(6, B) the last Newton update; scratch work (6, 7), own (6, 6), inertia (3, 3), out (6, B); keep (k,) int64 the
+rows a scene's dimension keeps (:func:`~ropesim.model.body_groups.kept_rows`); where (2,) int64 the first body
+member and the first body unknown in the groups."""
+
+
+def body_stage(model, groups) -> BodyStage:
+    """The scratch of the free bodies' stages for ``model`` with its Schur ``groups`` (bodies last)."""
+    count = model.body_pose0.shape[1]
+    k = body_unknowns(model.dim)
+    bundle = model.params.bodies
+    where = np.array([groups.nodes.size - bundle.nodes.size, int(groups.offset[-1]) - count * k], dtype=np.int64)
+    three, six = (lambda: np.zeros((3, count))), (lambda: np.zeros((6, count)))
+    return BodyStage(model.body_pose0.copy(), model.body_pose0.copy(), six(), three(), three(), six(), three(),
+                     three(), six(), np.zeros((6, 7)), np.zeros((6, 6)), np.zeros((3, 3)), six(),
+                     kept_rows(model.dim).astype(np.int64), where)
+
+
+@jit.kernel
+def start_step(body, pose, twist):
+    """The step's first stage: U_hat = (r_n, 0), W_hat = w_n, from the state ``pose``, ``twist``."""
+    for b in range(pose.shape[1]):
+        for d in range(7):
+            body.base[d, b] = pose[d, b]
+        for d in range(3):
+            body.hat_r[d, b] = pose[d, b]
+            body.hat_phi[d, b] = 0.0
+        for d in range(6):
+            body.hat_w[d, b] = twist[d, b]
+
+
+@jit.kernel
+def next_stage(body, twist, h, gamma):
+    """The second stage's known part from the first's W: U_hat = U_n + (1 - gamma) h W, W_hat = w_n + (1 - gamma) /
+    gamma (W - w_n) (as the nodes')."""
+    ratio = (1.0 - gamma) / gamma
+    for b in range(twist.shape[1]):
+        for d in range(3):
+            body.hat_r[d, b] = body.base[d, b] + (1.0 - gamma) * h * body.twist[d, b]
+            body.hat_phi[d, b] = (1.0 - gamma) * h * body.twist[3 + d, b]
+        for d in range(6):
+            body.hat_w[d, b] = twist[d, b] + ratio * (body.twist[d, b] - twist[d, b])
+
+
+@jit.kernel
+def guess_stage(body, beta):
+    """The Newton iteration's start: U = U_hat + beta W_hat."""
+    for b in range(body.r.shape[1]):
+        for d in range(3):
+            body.r[d, b] = body.hat_r[d, b] + beta * body.hat_w[d, b]
+            body.phi[d, b] = body.hat_phi[d, b] + beta * body.hat_w[3 + d, b]
+
+
+@jit.kernel
+def place_stage(body, X, V, beta, bodies, arm):
+    """The stage's pose (r, exp(phi) q_n) and twist ((U - U_hat) / beta), its attachments in ``X`` and ``V`` where
+    it holds them and their arms into the groups' ``arm``."""
+    for b in range(body.r.shape[1]):
+        for d in range(3):
+            body.pose[d, b] = body.r[d, b]
+            body.twist[d, b] = (body.r[d, b] - body.hat_r[d, b]) / beta
+            body.twist[3 + d, b] = (body.phi[d, b] - body.hat_phi[d, b]) / beta
+        for d in range(4):
+            body.pose[3 + d, b] = body.base[3 + d, b]
+        turn(body.pose[3:7], b, body.phi[0, b], body.phi[1, b], body.phi[2, b])
+    place_attachments(X, V, bodies, body.pose, body.twist)
+    set_body_arms(arm, body.where[0], bodies, body.pose)
+
+
+@jit.kernel(inline="always")
+def _add_centripetal(own, m00, m01, m02, m11, m12, m22, p0, p1, p2, w0, w1, w2, scale):
+    """Add scale times -d/dw of a mass M's centripetal force -M w x (w x p) at arm p, and of its moment, to
+    ``own``'s rotation columns: f = -M ([w x p]x + [w]x [p]x) into the force rows, p x f into the moment rows
+    ([w]x [p]x = p w^T - (w . p) I)."""
+    e0, e1, e2 = cross(w0, w1, w2, p0, p1, p2)
+    wp = w0 * p0 + w1 * p1 + w2 * p2
+    mm = ((m00, m01, m02), (m01, m11, m12), (m02, m12, m22))
+    ex = ((0.0, -e2, e1), (e2, 0.0, -e0), (-e1, e0, 0.0))
+    p = (p0, p1, p2)
+    w = (w0, w1, w2)
+    for j in range(3):
+        d0 = ex[0][j] + p[0] * w[j] - (wp if j == 0 else 0.0)
+        d1 = ex[1][j] + p[1] * w[j] - (wp if j == 1 else 0.0)
+        d2 = ex[2][j] + p[2] * w[j] - (wp if j == 2 else 0.0)
+        f0 = -(mm[0][0] * d0 + mm[0][1] * d1 + mm[0][2] * d2)
+        f1 = -(mm[1][0] * d0 + mm[1][1] * d1 + mm[1][2] * d2)
+        f2 = -(mm[2][0] * d0 + mm[2][1] * d1 + mm[2][2] * d2)
+        own[0, 3 + j] += scale * f0
+        own[1, 3 + j] += scale * f1
+        own[2, 3 + j] += scale * f2
+        t0, t1, t2 = cross(p0, p1, p2, f0, f1, f2)
+        own[3, 3 + j] += scale * t0
+        own[4, 3 + j] += scale * t1
+        own[5, 3 + j] += scale * t2
+
+
+@jit.kernel(inline="always")
+def _add_turning_force(own, f0, f1, f2, p0, p1, p2, scale):
+    """Add scale times K_phi = (F . p) I - p F^T of a force F at arm p that turns with the body (rotation block)."""
+    fp = f0 * p0 + f1 * p1 + f2 * p2
+    f = (f0, f1, f2)
+    p = (p0, p1, p2)
+    for i in range(3):
+        for j in range(3):
+            own[3 + i, 3 + j] += scale * ((fp if i == j else 0.0) - p[i] * f[j])
+
+
+@jit.kernel(inline="always")
+def _add_drag_rate(own, row, r, d0, d1, d2, u0, u1, u2, scale):
+    """Add scale times R diag(d) (|u| I + u u^T / |u|) R^T (u in body axes) to the 3 x 3 block at (row, row)."""
+    speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+    if speed == 0.0:
+        return
+    u = (u0, u1, u2)
+    dd = (d0, d1, d2)
+    for i in range(3):
+        for j in range(3):
+            s = 0.0
+            for k in range(3):
+                for l in range(3):
+                    body = dd[k] * ((speed if k == l else 0.0) + u[k] * u[l] / speed)
+                    s += r[3 * i + k] * body * r[3 * j + l]
+            own[row + i, row + j] += scale * s
+
+
+@jit.kernel
+def stage_rows(body, X, acc, beta, t, p, groups, rhs):
+    """Every body's stage residual R_b into the groups' ``own_rhs`` and its own block O into ``own`` (see the
+    module doc), from ``acc`` holding every node's F / m at the stage; its attachments' rows of ``rhs`` zeroed.
+    Returns the squared norm of the bodies' residuals."""
+    dim = X.shape[0]
+    bodies = p.bodies
+    g = p.gravity[0] if WITH_GRAVITY else 0.0
+    work, own, inertia, keep = body.work, body.own, body.inertia, body.keep
+    k = keep.shape[0]
+    first = body.where[1]
+    norm = 0.0
+    for b in range(body.r.shape[1]):
+        pose, twist = body.pose, body.twist
+        body_own_system(work, g, p.flow, bodies, pose, twist, b, t, 0.0)
+        body_attachments_system(work, X, acc, p.inv_mass, p.neighbours, bodies, pose, twist, b)
+        r = matrix_of(pose[3:7], b)
+        w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
+        for i in range(6):
+            s = 0.0
+            for j in range(6):
+                s += work[i, j] * (twist[j, b] - body.hat_w[j, b])
+                own[i, j] = work[i, j]
+            work[i, 6] = -beta * (s - beta * work[i, 6])
+        # the plain attachment masses the band holds; the turning forces; the centripetal and drag rates
+        m = bodies.mass[b]
+        c0, c1, c2 = r[0] * bodies.cog[0, b] + r[1] * bodies.cog[1, b] + r[2] * bodies.cog[2, b], \
+            r[3] * bodies.cog[0, b] + r[4] * bodies.cog[1, b] + r[5] * bodies.cog[2, b], \
+            r[6] * bodies.cog[0, b] + r[7] * bodies.cog[1, b] + r[8] * bodies.cog[2, b]
+        _add_turning_force(own, 0.0, -m * g, 0.0, c0, c1, c2, beta * beta)
+        _add_centripetal(own, m, 0.0, 0.0, m, 0.0, m, c0, c1, c2, w0, w1, w2, beta)
+        lift = bodies.lift[b]
+        if lift != 0.0:
+            k0 = r[0] * bodies.cob[0, b] + r[1] * bodies.cob[1, b] + r[2] * bodies.cob[2, b]
+            k1 = r[3] * bodies.cob[0, b] + r[4] * bodies.cob[1, b] + r[5] * bodies.cob[2, b]
+            k2 = r[6] * bodies.cob[0, b] + r[7] * bodies.cob[1, b] + r[8] * bodies.cob[2, b]
+            _add_turning_force(own, 0.0, lift, 0.0, k0, k1, k2, beta * beta)
+        for c in range(bodies.start[b], bodies.start[b + 1]):
+            i = bodies.nodes[c]
+            mi = 1.0 / p.inv_mass[i]
+            p0 = groups.arm[0, body.where[0] + c]
+            p1 = groups.arm[1, body.where[0] + c]
+            p2 = groups.arm[2, body.where[0] + c]
+            _add_mass_at(own, -mi, 0.0, 0.0, -mi, 0.0, -mi, p0, p1, p2)
+            a2 = acc[2, i] if dim == 3 else 0.0
+            _add_turning_force(own, mi * acc[0, i], mi * acc[1, i], mi * a2, p0, p1, p2, beta * beta)
+            a_n, a_t = bodies.node_added[0, c], bodies.node_added[1, c]
+            q0, q1, q2 = node_tangent(X, i, p.neighbours)
+            extra = a_t - a_n
+            _add_centripetal(own, mi + a_n + extra * q0 * q0, extra * q0 * q1, extra * q0 * q2,
+                             mi + a_n + extra * q1 * q1, extra * q1 * q2, mi + a_n + extra * q2 * q2,
+                             p0, p1, p2, w0, w1, w2, beta)
+        # the gyroscopic moment: [w]x I - [I w]x, I = R I_b R^T
+        for i in range(3):
+            for j in range(3):
+                s = 0.0
+                for a in range(3):
+                    for c in range(3):
+                        s += r[3 * i + a] * bodies.inertia[a, c, b] * r[3 * j + c]
+                inertia[i, j] = s
+        i0 = inertia[0, 0] * w0 + inertia[0, 1] * w1 + inertia[0, 2] * w2
+        i1 = inertia[1, 0] * w0 + inertia[1, 1] * w1 + inertia[1, 2] * w2
+        i2 = inertia[2, 0] * w0 + inertia[2, 1] * w1 + inertia[2, 2] * w2
+        for j in range(3):
+            e0, e1, e2 = cross(w0, w1, w2, inertia[0, j], inertia[1, j], inertia[2, j])
+            own[3, 3 + j] += beta * e0
+            own[4, 3 + j] += beta * e1
+            own[5, 3 + j] += beta * e2
+        own[3, 4] += beta * i2     # - [I w]x
+        own[3, 5] -= beta * i1
+        own[4, 3] -= beta * i2
+        own[4, 5] += beta * i0
+        own[5, 3] += beta * i1
+        own[5, 4] -= beta * i0
+        # drag on the flow relative to the reference point, and the rotational drag
+        u0, u1, u2 = -twist[0, b], -twist[1, b], -twist[2, b]
+        if WITH_FLOW:
+            U0, U1, U2 = flow_at(pose[1, b], t, p.flow[0], p.flow[1])
+            u0 += U0
+            u1 += U1
+            u2 += U2
+        ub = rotate_back(r, u0, u1, u2)
+        _add_drag_rate(own, 0, r, bodies.drag[0, b], bodies.drag[1, b], bodies.drag[2, b], ub[0], ub[1], ub[2], beta)
+        wb = rotate_back(r, w0, w1, w2)
+        _add_drag_rate(own, 3, r, bodies.drag_rot[0, b], bodies.drag_rot[1, b], bodies.drag_rot[2, b], wb[0], wb[1],
+                       wb[2], beta)
+        at = first + b * k
+        for a in range(k):
+            groups.own_rhs[at + a] = work[keep[a], 6]
+            norm += work[keep[a], 6] * work[keep[a], 6]
+            for c in range(k):
+                groups.own[at + a, at + c] = own[keep[a], keep[c]]
+        for c in range(bodies.start[b], bodies.start[b + 1]):
+            i = bodies.nodes[c]
+            for d in range(dim):
+                rhs[i * dim + d] = 0.0
+    return norm
+
+
+@jit.kernel
+def take_body_update(body, groups):
+    """U += the bodies' Newton update (the groups' du), kept in ``step``. Returns its largest translation [m]."""
+    keep = body.keep
+    k = keep.shape[0]
+    first = body.where[1]
+    worst = 0.0
+    for b in range(body.r.shape[1]):
+        for d in range(6):
+            body.step[d, b] = 0.0
+        for a in range(k):
+            body.step[keep[a], b] = groups.du[first + b * k + a]
+        for d in range(3):
+            body.r[d, b] += body.step[d, b]
+            body.phi[d, b] += body.step[3 + d, b]
+            if not abs(body.step[d, b]) <= worst:
+                worst = abs(body.step[d, b])
+    return worst
+
+
+@jit.kernel
+def take_back_half_bodies(body):
+    """Halve the bodies' last update and take that half back."""
+    for b in range(body.r.shape[1]):
+        for d in range(3):
+            body.step[d, b] *= 0.5
+            body.step[3 + d, b] *= 0.5
+            body.r[d, b] -= body.step[d, b]
+            body.phi[d, b] -= body.step[3 + d, b]
+
+
+@jit.kernel
+def end_step_bodies(body, pose, twist):
+    """The step's end (stiffly accurate): the state takes the last stage's pose and twist."""
+    for b in range(pose.shape[1]):
+        for d in range(7):
+            pose[d, b] = body.pose[d, b]
+        for d in range(6):
+            twist[d, b] = body.twist[d, b]
