@@ -15,7 +15,7 @@ from typing import Any
 from . import schema as S
 from .builtin import resolve
 from .errors import SceneError
-from .material import agree, mass_per_length, per_node
+from .material import agree, mass_per_length, per_node, resolve_axial_damping
 from .motion import complete_motion
 from .system import (POINT_BODY_IN_A_SYSTEM, RIGID_BODY_IN_A_ROPE, ROPE_ONLY_INSTEAD, SYSTEM_ONLY_INSTEAD,
                      resolve_system)
@@ -381,7 +381,11 @@ def _resolve_rope(rope: S.Rope, source: str) -> S.Rope:
                 spec = {f.name: f.metadata["spec"] for f in fields(S.Rope)}[key]
                 fail(key, f"missing: {spec.doc}{unit_of(spec)}; or give the rope in physical units (length, "
                           f"segments, mass_per_length, EA)")
-        return replace(rope, compression=True if rope.compression is None else rope.compression)
+        l0 = rope.segment_length
+        damping = resolve_axial_damping(rope.axial_damping, rope.axial_damping_ratio, l0, rope.stiffness * l0,
+                                        rope.mass / l0, fail)
+        return replace(rope, compression=True if rope.compression is None else rope.compression,
+                       axial_damping=damping)
     for key in ("length", "EA"):
         if getattr(rope, key) is None:
             fail(key, f"missing: a rope in physical units needs length, EA, segments (or nodes) and "
@@ -405,7 +409,9 @@ def _resolve_rope(rope: S.Rope, source: str) -> S.Rope:
         if given is not None and not agree(given, value):
             fail(key, f"{given:g} contradicts the physical form, which gives {value:g}; give one form, or both "
                       f"consistently")
-    return replace(rope, segments=segments, mass_per_length=per_metre,
+    damping = resolve_axial_damping(rope.axial_damping, rope.axial_damping_ratio, derived["segment_length"],
+                                    rope.EA, per_metre, fail)
+    return replace(rope, segments=segments, mass_per_length=per_metre, axial_damping=damping,
                    compression=False if rope.compression is None else rope.compression, **derived)
 
 

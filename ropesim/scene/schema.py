@@ -66,7 +66,10 @@ class Rope:
       touches, so an open line's two end nodes carry half a segment (MoorDyn's convention). The resolved
       scene shows both forms.
 
-    ``axial_damping`` (BA) adds a force BA (dl/dt) / l along each segment, in tension and compression.
+    ``axial_damping`` (BA) adds a force BA (dl/dt) / l along each segment, in tension and compression; or give
+    ``axial_damping_ratio`` zeta, a fraction of each segment's critical damping (MoorDyn's negative BA): BA = zeta
+    l sqrt(EA m'), since a segment between two nodes of m' l / 2 stretches with critical damping sqrt(EA m') (per
+    node, EA = k l and m' = m / l). The resolved scene shows both.
     ``EI`` gives the rope bending stiffness: each joint between segments stores EI (1 - cos theta) / l_j, theta
     the angle between the two segments and l_j the mean of their rest lengths (EI kappa^2 / 2 per length for
     small angles, kappa = theta / l_j); the forces are that energy's gradient.
@@ -98,6 +101,9 @@ class Rope:
                             open_low=True)
     axial_damping: float | None = spec("float", "internal damping BA: force BA (dl/dt) / l along each segment",
                                        "N s", default=None, required=False, low=0)
+    axial_damping_ratio: float | None = spec("float", "internal damping as a fraction zeta of each segment's "
+                                                      "critical damping (MoorDyn's negative BA): BA = zeta l "
+                                                      "sqrt(EA m')", default=None, required=False, low=0)
     EI: float | None = spec("float", "bending stiffness EI: energy EI (1 - cos theta) / l at each joint",
                             "N m^2", default=None, required=False, low=0, open_low=True)
     compression: bool | None = spec("bool", "segments push back when shorter than their rest length (default: "
@@ -282,7 +288,8 @@ class LineType:
     """A line material, named under ``[line_types.NAME]`` and used by ``[[lines]]`` through ``type = "NAME"``:
     the physical form of ``[rope]`` (diameter, mass per metre or density, EA, axial damping BA, EI), and the
     fluid coefficients of lines of this type where they differ from the scene's ``[fluid_drag]`` and
-    ``[added_mass]`` (MoorDyn's line types carry Cd, Ca, CdAx and CaAx)."""
+    ``[added_mass]`` (MoorDyn's line types carry Cd, Ca, CdAx and CaAx). ``axial_damping_ratio`` (as ``[rope]``'s)
+    gives each line of this type the BA of its own segment length."""
 
     diameter: float | None = spec("float", "diameter d: the area drag, buoyancy and added mass act on", "m",
                                   default=None, required=False, low=0, open_low=True)
@@ -293,6 +300,9 @@ class LineType:
     EA: float | None = spec("float", "axial stiffness EA", "N", default=None, required=False, low=0, open_low=True)
     axial_damping: float | None = spec("float", "internal damping BA: force BA (dl/dt) / l along each segment",
                                        "N s", default=None, required=False, low=0)
+    axial_damping_ratio: float | None = spec("float", "internal damping as a fraction zeta of each segment's "
+                                                      "critical damping (MoorDyn's negative BA): BA = zeta l "
+                                                      "sqrt(EA m')", default=None, required=False, low=0)
     EI: float | None = spec("float", "bending stiffness EI: energy EI (1 - cos theta) / l at each joint",
                             "N m^2", default=None, required=False, low=0, open_low=True)
     compression: bool | None = spec("bool", "segments push back when shorter than their rest length (default "
@@ -333,6 +343,9 @@ class Line:
     EA: float | None = spec("float", "axial stiffness EA", "N", default=None, required=False, low=0, open_low=True)
     axial_damping: float | None = spec("float", "internal damping BA: force BA (dl/dt) / l along each segment",
                                        "N s", default=None, required=False, low=0)
+    axial_damping_ratio: float | None = spec("float", "internal damping as a fraction zeta of each segment's "
+                                                      "critical damping (MoorDyn's negative BA): BA = zeta l "
+                                                      "sqrt(EA m')", default=None, required=False, low=0)
     EI: float | None = spec("float", "bending stiffness EI: energy EI (1 - cos theta) / l at each joint",
                             "N m^2", default=None, required=False, low=0, open_low=True)
     compression: bool | None = spec("bool", "segments push back when shorter than their rest length (default "
