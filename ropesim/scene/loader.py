@@ -346,7 +346,7 @@ def _check_seabed(scene: S.Scene, fail) -> None:
             fail("seabed.contact_width", f"missing: the seabed pushes on a footprint contact_width x node length; "
                                          f"give it, or every line's diameter (lines.{bare[0]} has none)")
         held = [(f"{p.kind} point '{p.id}' (points.{j}, at y = {p.position[1]:.6g} m)", p.position[0], p.position[1])
-                for j, p in enumerate(scene.points) if p.kind in ("fixed", "driven")]
+                for j, p in enumerate(scene.points) if p.kind in (*S.STILL_KINDS, "driven")]
     else:
         if bed.contact_width is None and scene.rope.diameter is None:
             fail("seabed.contact_width", "missing: the seabed pushes on a footprint contact_width x node length; "

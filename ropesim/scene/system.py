@@ -182,6 +182,7 @@ def _resolve_point(scene: S.Scene, j: int, point: S.Point, base_dir: Path, fail)
 
 def _held_by(kind: str) -> str:
     return {"fixed": "it stays where it is, whatever acts on it",
+            "coupled": "the program it is coupled to moves it (a run of the scene alone holds it still)",
             "driven": "it follows its prescribed motion, whatever acts on it",
             "body": "it moves with its body (give the body its mass, volume and drag)"}[kind]
 
