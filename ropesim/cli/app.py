@@ -175,9 +175,23 @@ def _load(scene: str, sets: list[str] | None):
 
     source = _source(scene)
     try:
-        return load_scene(scene, sets or []), source.label
+        loaded = load_scene(scene, sets or []), source.label
     except SceneError as exc:
         fail(str(exc))
+    _say_what_moordyn_loses(source.path)
+    return loaded
+
+
+def _say_what_moordyn_loses(path: Path) -> None:
+    """A MoorDyn input file run directly: what its scene does without, one line each on stderr."""
+    if path.suffix.lower() == ".toml":
+        return
+    from ..scene.moordyn import looks_like_moordyn, read_moordyn
+
+    text = path.read_text(encoding="utf-8", errors="replace")
+    if looks_like_moordyn(text):
+        for note in read_moordyn(text, str(path)).notes:
+            typer.echo(f"ropesim: {path}: not translated: {note}", err=True)
 
 
 @app.command(cls=Command, rich_help_panel=RUNNING)
@@ -545,6 +559,59 @@ def scenarios() -> None:
     width = max(map(len, names))
     for name in names:
         typer.echo(f"{name:<{width}}  {describe(builtin_path(name))}")
+
+
+import_app = typer.Typer(name="import", cls=Group, no_args_is_help=True,
+                         help="Write a scene file from another program's input file (MoorDyn's).")
+app.add_typer(import_app, rich_help_panel=SCENES)
+
+
+@import_app.command(cls=Command, name="moordyn")
+def import_moordyn(
+    file: Annotated[Path, typer.Argument(metavar="FILE", help="A MoorDyn v2 input file (lines.txt, ...).",
+                                         show_default=False)],
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="The scene file to write (default: FILE's "
+                                                "name with .toml, in the current folder).",
+                                                show_default=False)] = None,
+    force: Annotated[bool, typer.Option("--force", help="Replace the scene file if it exists.")] = False,
+) -> None:
+    """Write a commented scene file from a MoorDyn v2 input file: its line types, points, lines, bodies and
+    options in ropesim's keys, MoorDyn's conventions mapped exactly.
+
+    Where ropesim's law differs from MoorDyn's, the scene says so in a comment; what it does not translate (output
+    channels, the IC solver's settings) is listed at its top and here, one line each. A file that needs what
+    ropesim lacks (rods, waves, currents, VIV, nonlinear lines) is refused in one line. `ropesim run FILE` runs a
+    MoorDyn file directly.
+    """
+    from ..io.atomic import write_text_atomic
+    from ..io.guard import output_file
+    from ..scene.loader import SceneError, scene_from_dict
+    from ..scene.moordyn import read_moordyn, scene_text
+
+    label = str(file)
+    try:
+        text = file.read_text(encoding="utf-8", errors="replace")
+    except FileNotFoundError:
+        fail(f"{label}: no such file")
+    except OSError as exc:
+        fail(f"{label}: cannot be read ({exc.strerror or exc.__class__.__name__})")
+    target = out if out is not None else Path(f"{file.stem}.toml")
+    name = target.stem
+    try:
+        translation = read_moordyn(text, label)
+        scene_from_dict({"name": name, **translation.scene}, source=f"{label} (imported)",
+                        base_dir=file.resolve().parent)
+    except SceneError as exc:
+        fail(str(exc))
+    real = _may_write(lambda: output_file(target, replace=force, force_hint=True))
+    try:
+        write_text_atomic(real, scene_text(translation, label, name))
+    except OSError as exc:
+        fail(_write_failure(exc, target), EXIT_WRITE)
+    for note in translation.notes:
+        typer.echo(f"ropesim: {label}: not translated: {note}", err=True)
+    typer.echo(f"{target}: MoorDyn's {label} as a scene ({len(translation.notes)} things not translated, listed "
+               f"at its top); then `ropesim run {target}`")
 
 
 @app.command(cls=Command, rich_help_panel=SCENES)

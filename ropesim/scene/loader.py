@@ -46,8 +46,27 @@ def load_scene(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) ->
         raise SceneError(source, "", "is a folder, not a scene file") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise SceneError(source, "", f"cannot be read ({exc.__class__.__name__})") from None
+    if path.suffix.lower() != ".toml":
+        from .moordyn import looks_like_moordyn
+
+        if looks_like_moordyn(text):
+            return scene_from_moordyn(text, source=source, default_name=path.stem, overrides=overrides,
+                                      base_dir=path.resolve().parent)
     return scene_from_toml(text, source=source, default_name=path.stem, overrides=overrides,
                            base_dir=path.resolve().parent)
+
+
+def scene_from_moordyn(text: str, source: str = "<moordyn>", default_name: str = "scene",
+                       overrides: list[str] | tuple[str, ...] = (), base_dir: str | Path | None = None) -> S.Scene:
+    """The scene of a MoorDyn v2 input file's text (:mod:`ropesim.scene.moordyn`; what it leaves out is in
+    ``read_moordyn(text).notes``), with ``--set`` style overrides applied; raises :class:`SceneError`."""
+    from .moordyn import read_moordyn
+
+    raw = {"name": default_name, **read_moordyn(text, source).scene}
+    for item in overrides:
+        apply_override(raw, item, source)
+    label = f"{source} (imported from MoorDyn{', with --set ' + ' '.join(overrides) if overrides else ''})"
+    return scene_from_dict(raw, source=label, default_name=default_name, base_dir=base_dir)
 
 
 def scene_from_toml(text: str, source: str = "<scene>", default_name: str = "scene",
