@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import inspect
 import sys
+from enum import Enum
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -561,22 +562,26 @@ def scenarios() -> None:
         typer.echo(f"{name:<{width}}  {describe(builtin_path(name))}")
 
 
-import_app = typer.Typer(name="import", cls=Group, no_args_is_help=True,
-                         help="Write a scene file from another program's input file (MoorDyn's).")
-app.add_typer(import_app, rich_help_panel=SCENES)
+class ImportFormat(str, Enum):
+    """The input files `ropesim import` reads."""
+
+    moordyn = "moordyn"
 
 
-@import_app.command(cls=Command, name="moordyn")
-def import_moordyn(
-    file: Annotated[Path, typer.Argument(metavar="FILE", help="A MoorDyn v2 input file (lines.txt, ...).",
+@app.command(cls=Command, rich_help_panel=SCENES, name="import")
+def import_(
+    format_: Annotated[ImportFormat, typer.Argument(metavar="FORMAT", help="The program whose input file FILE is: "
+                                                    "moordyn (MoorDyn v2).", show_default=False)],
+    file: Annotated[Path, typer.Argument(metavar="FILE", help="The input file (a MoorDyn v2 file: lines.txt, ...).",
                                          show_default=False)],
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="The scene file to write (default: FILE's "
                                                 "name with .toml, in the current folder).",
                                                 show_default=False)] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace the scene file if it exists.")] = False,
 ) -> None:
-    """Write a commented scene file from a MoorDyn v2 input file: its line types, points, lines, bodies and
-    options in ropesim's keys, MoorDyn's conventions mapped exactly.
+    """Write a commented scene file from another program's input file: `ropesim import moordyn lines.txt` turns a
+    MoorDyn v2 file's line types, points, lines, bodies and options into ropesim's keys, MoorDyn's conventions
+    mapped exactly.
 
     Where ropesim's law differs from MoorDyn's, the scene says so in a comment; what it does not translate (output
     channels, the IC solver's settings) is listed at its top and here, one line each. A file that needs what
