@@ -159,7 +159,7 @@ def test_lines_txt_statics_agree_with_moordyns_own():
     """OC3-Hywind's three chains, their fairleads held: each line's fairlead and anchor tension within 1e-5 of
     MoorDyn's (the issue asks 0.2 %; MoorDyn's relaxation stops about 2e-6 short, see the reference), and every node
     within 2 mm of MoorDyn's (of a 902 m line), after the frame's rotation (x, y, z) -> (x, z, -y)."""
-    stored = json.loads((DATA / "lines_statics.json").read_text())
+    stored = json.loads((DATA / "import" / "lines_statics.json").read_text())
     scene = load_scene(MOORING / "lines.txt", ["integrator.t_end=0.002", "output.interval=0.002"])
     traj = ropesim.simulate(scene)
     for line_id, figures in stored["lines"].items():

@@ -170,8 +170,9 @@ def _source(scene: str):
         fail(str(exc))
 
 
-def _load(scene: str, sets: list[str] | None):
-    """The scene a SCENE argument means, validated, with ``--set`` applied, and how to name it in messages."""
+def _load(scene: str, sets: list[str] | None, quiet: bool = False):
+    """The scene a SCENE argument means, validated, with ``--set`` applied, and how to name it in messages (a
+    MoorDyn input file's untranslated parts said on stderr unless ``quiet``)."""
     from ..scene.loader import SceneError, load_scene
 
     source = _source(scene)
@@ -179,7 +180,8 @@ def _load(scene: str, sets: list[str] | None):
         loaded = load_scene(scene, sets or []), source.label
     except SceneError as exc:
         fail(str(exc))
-    _say_what_moordyn_loses(source.path)
+    if not quiet:
+        _say_what_moordyn_loses(source.path)
     return loaded
 
 
@@ -268,7 +270,7 @@ def _run_command(scene_file, out, sets, resume, quiet, force, progress, status):
     else:
         if scene_file is None:
             fail("missing SCENE: a scene file or a built-in scene's name (or --resume RUN_DIR)")
-        scene, where = _load(scene_file, sets)
+        scene, where = _load(scene_file, sets, quiet)
         status.update(f"Preparing {scene.name}", kernel=f"the {scene.integrator.method} kernel")
         status.watch()   # imports Numba, which the checks below need anyway
         _check_time_step(scene, where, force, quiet)

@@ -366,7 +366,7 @@ class _Translator:
                                f"[line_types] table by it)")
             if name in types:
                 self.fail(row, f"line type '{name}' is given twice")
-            if len(row.cells) > 10 and any(_number(row, 10, "Cl", self.source) != 0 for _ in (0,)):
+            if len(row.cells) > 10 and _number(row, 10, "Cl", self.source) != 0:
                 self.fail(row, f"line type '{name}' has a lift coefficient Cl (VIV): ropesim has no vortex-induced "
                                f"vibration")
             for i, what in ((3, "EA"), (4, "BA")):

@@ -1,6 +1,6 @@
 """MoorDyn's own statics of its OC3-Hywind mooring (tests/Mooring/lines.txt), stored for
 ``tests/test_moordyn_import.py`` so that the test needs no MoorDyn: ``python -m tests.references.moordyn_lines_statics``
-(with ``pip install moordyn``) writes ``tests/data/moordyn/lines_statics.json``.
+(with ``pip install moordyn``) writes ``tests/data/moordyn/import/lines_statics.json``.
 
 MoorDyn runs the file as it is but for its initial-condition settings: its dynamic relaxation (``ICgenDynamic 1``)
 run tight (threshIC 1e-10, TmaxIC 3000 s, CdScaleIC 10) so that it stops at the static state itself (to about 2e-6
@@ -21,7 +21,7 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 SOURCE = HERE.parent / "data" / "moordyn" / "mooring" / "lines.txt"
-STORED = HERE.parent / "data" / "moordyn" / "lines_statics.json"
+STORED = HERE.parent / "data" / "moordyn" / "import" / "lines_statics.json"
 TIGHT = {"ICgenDynamic": 1, "threshIC": 1e-10, "TmaxIC": 3000, "CdScaleIC": 10, "writeLog": 0}
 
 
