@@ -260,6 +260,8 @@ def test_import_writes_a_commented_scene_that_loads_as_the_file_runs(tmp_path):
     assert load_scene(out).lines == load_scene(MOORING / "lines.txt").lines
     again = _cli("import", "moordyn", str(MOORING / "lines.txt"), "--out", str(out))
     assert again.returncode == 2 and "exists; add --force" in again.stderr
+    checked = _cli("check", str(MOORING / "lines.txt"))
+    assert checked.returncode == 0 and checked.stderr.count("not translated: ") == 3
 
 
 BAD = {   # (what to change in lines.txt, the line number, the message)
