@@ -28,7 +28,7 @@ def test_every_command_sits_in_one_help_panel():
     ctx = typer.Context(group, info_name="ropesim")
     panels = {name: group.get_command(ctx, name).rich_help_panel for name in group.list_commands(ctx)}
     assert set(panels.values()) == {RUNNING, SCENES, STUDIES, PICTURES}, panels
-    assert len(panels) == 15      # view (issue 25) joined the pictures panel
+    assert len(panels) == 16      # view (issue 25) joined the pictures panel, import (issue 21) the scenes panel
     text = invoke("--help").stdout
     assert all(panel in text for panel in (RUNNING, SCENES, STUDIES, PICTURES))
     assert text.index(f"─ {RUNNING} ") < text.index("│ run ") < text.index(f"─ {PICTURES} ") < text.index("│ export ")

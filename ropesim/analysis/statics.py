@@ -164,7 +164,7 @@ def _point_figures(model: Model, x: np.ndarray, supports: np.ndarray) -> tuple[P
         if not ends:
             continue
         force = None
-        if point.kind in ("fixed", "driven"):
+        if point.kind in (*S.STILL_KINDS, "driven"):
             force = sum(supports[row[i]] for i in ends)
         out.append(PointFigures(point.id, point.kind, x[:, ends[0]].copy(), force))
     return tuple(out)

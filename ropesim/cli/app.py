@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import inspect
 import sys
+from enum import Enum
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -169,15 +170,31 @@ def _source(scene: str):
         fail(str(exc))
 
 
-def _load(scene: str, sets: list[str] | None):
-    """The scene a SCENE argument means, validated, with ``--set`` applied, and how to name it in messages."""
+def _load(scene: str, sets: list[str] | None, quiet: bool = False):
+    """The scene a SCENE argument means, validated, with ``--set`` applied, and how to name it in messages (a
+    MoorDyn input file's untranslated parts said on stderr unless ``quiet``)."""
     from ..scene.loader import SceneError, load_scene
 
     source = _source(scene)
     try:
-        return load_scene(scene, sets or []), source.label
+        loaded = load_scene(scene, sets or []), source.label
     except SceneError as exc:
         fail(str(exc))
+    if not quiet:
+        _say_what_moordyn_loses(source.path)
+    return loaded
+
+
+def _say_what_moordyn_loses(path: Path) -> None:
+    """A MoorDyn input file run directly: what its scene does without, one line each on stderr."""
+    if path.suffix.lower() == ".toml":
+        return
+    from ..scene.moordyn import looks_like_moordyn, read_moordyn
+
+    text = path.read_text(encoding="utf-8", errors="replace")
+    if looks_like_moordyn(text):
+        for note in read_moordyn(text, str(path)).notes:
+            typer.echo(f"ropesim: {path}: not translated: {note}", err=True)
 
 
 @app.command(cls=Command, rich_help_panel=RUNNING)
@@ -253,7 +270,7 @@ def _run_command(scene_file, out, sets, resume, quiet, force, progress, status):
     else:
         if scene_file is None:
             fail("missing SCENE: a scene file or a built-in scene's name (or --resume RUN_DIR)")
-        scene, where = _load(scene_file, sets)
+        scene, where = _load(scene_file, sets, quiet)
         status.update(f"Preparing {scene.name}", kernel=f"the {scene.integrator.method} kernel")
         status.watch()   # imports Numba, which the checks below need anyway
         _check_time_step(scene, where, force, quiet)
@@ -547,6 +564,63 @@ def scenarios() -> None:
     width = max(map(len, names))
     for name in names:
         typer.echo(f"{name:<{width}}  {describe(builtin_path(name))}")
+
+
+class ImportFormat(str, Enum):
+    """The input files `ropesim import` reads."""
+
+    moordyn = "moordyn"
+
+
+@app.command(cls=Command, rich_help_panel=SCENES, name="import")
+def import_(
+    format_: Annotated[ImportFormat, typer.Argument(metavar="FORMAT", help="The program whose input file FILE is: "
+                                                    "moordyn (MoorDyn v2).", show_default=False)],
+    file: Annotated[Path, typer.Argument(metavar="FILE", help="The input file (a MoorDyn v2 file: lines.txt, ...).",
+                                         show_default=False)],
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="The scene file to write (default: FILE's "
+                                                "name with .toml, in the current folder).",
+                                                show_default=False)] = None,
+    force: Annotated[bool, typer.Option("--force", help="Replace the scene file if it exists.")] = False,
+) -> None:
+    """Write a commented scene file from another program's input file: `ropesim import moordyn lines.txt` turns a
+    MoorDyn v2 file's line types, points, lines, bodies and options into ropesim's keys, MoorDyn's conventions
+    mapped exactly.
+
+    Where ropesim's law differs from MoorDyn's, the scene says so in a comment; what it does not translate (output
+    channels, the IC solver's settings) is listed at its top and here, one line each. A file that needs what
+    ropesim lacks (rods, waves, currents, VIV, nonlinear lines) is refused in one line. `ropesim run FILE` runs a
+    MoorDyn file directly.
+    """
+    from ..io.atomic import write_text_atomic
+    from ..io.guard import output_file
+    from ..scene.loader import SceneError, scene_from_dict
+    from ..scene.moordyn import read_moordyn, scene_text
+
+    label = str(file)
+    try:
+        text = file.read_text(encoding="utf-8", errors="replace")
+    except FileNotFoundError:
+        fail(f"{label}: no such file")
+    except OSError as exc:
+        fail(f"{label}: cannot be read ({exc.strerror or exc.__class__.__name__})")
+    target = out if out is not None else Path(f"{file.stem}.toml")
+    name = target.stem
+    try:
+        translation = read_moordyn(text, label)
+        scene_from_dict({"name": name, **translation.scene}, source=f"{label} (imported)",
+                        base_dir=file.resolve().parent)
+    except SceneError as exc:
+        fail(str(exc))
+    real = _may_write(lambda: output_file(target, replace=force, force_hint=True))
+    try:
+        write_text_atomic(real, scene_text(translation, label, name))
+    except OSError as exc:
+        fail(_write_failure(exc, target), EXIT_WRITE)
+    for note in translation.notes:
+        typer.echo(f"ropesim: {label}: not translated: {note}", err=True)
+    typer.echo(f"{target}: MoorDyn's {label} as a scene ({len(translation.notes)} things not translated, listed "
+               f"at its top); then `ropesim run {target}`")
 
 
 @app.command(cls=Command, rich_help_panel=SCENES)

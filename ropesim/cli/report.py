@@ -257,6 +257,8 @@ def _point_text(point) -> str:
         return f"free, starting at {where} m; {', '.join(parts)}"
     if point.kind == "driven":
         return f"driven from {where} m " + _motion_text(point)
+    if point.kind == "coupled":
+        return f"coupled at {where} m (held there in a run of the scene alone)"
     return f"fixed at {where} m"
 
 

@@ -50,6 +50,7 @@ import numpy as np
 
 from . import jit
 from .forces.fluid import WITH_FLOW, flow_at, node_tangent
+from ..scene.schema import STILL_KINDS
 from .rotation import cross, matrix_of, quaternion_from_angles, rotate, rotate_back, turn
 
 WITH_BODIES = jit.Switch("bodies", "free rigid bodies")
@@ -511,7 +512,7 @@ def body_frames(model, t: np.ndarray, state: np.ndarray | None) -> dict[str, np.
             out["body_q"][:, b] = rows[:, 3:7]
             out["body_v"][:, b] = rows[:, POSE:POSE + dim]
             out["body_w"][:, b] = rows[:, POSE + 3:POSE + 6]
-        elif body.kind == "fixed":
+        elif body.kind in STILL_KINDS:
             pose = initial_pose(body, dim)
             out["body_x"][:, b] = pose[:dim]
             out["body_q"][:, b] = pose[3:]

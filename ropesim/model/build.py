@@ -190,7 +190,7 @@ def _system_nodes(scene: S.Scene, lines) -> Nodes:
     ends = point_ends(scene, lines)
     for point_id, on_point in ends.items():
         point = points[point_id]
-        if point.kind in ("fixed", "driven") and on_point:
+        if point.kind in (*S.STILL_KINDS, "driven") and on_point:
             held[on_point] = True
         if point.kind == "driven" and on_point:
             held_v[:, on_point] = np.asarray(point.velocity)[:, None]

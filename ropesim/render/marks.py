@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.build import Model
+from ..scene.schema import STILL_KINDS
 
 NODE_SIZE = 2.6          # [pt] marker of an ordinary node in the pictures
 HEAVY_MIN_SCALE, HEAVY_MAX_SCALE = 1.5, 4.0   # a heavy node's marker grows as sqrt(mass ratio), within these
@@ -95,7 +96,7 @@ def moving_marks(model: Model) -> list[Mark]:
 def pinned_mark(model: Model) -> Mark | None:
     """The pinned nodes, a system's fixed points (they stay where the scene starts them), or None."""
     if model.scene.is_system:
-        fixed = _point_nodes(model, "fixed")
+        fixed = _point_nodes(model, *STILL_KINDS)
         return Mark("fixed point", fixed, "pinned") if fixed.size else None
     pinned = model.scene.pinned
     if pinned is None:
@@ -103,12 +104,13 @@ def pinned_mark(model: Model) -> Mark | None:
     return Mark("pinned node", np.array([model.scene.node(i) for i in pinned.nodes]), "pinned")
 
 
-def _point_nodes(model: Model, kind: str) -> np.ndarray:
-    """The first line end's node of each of a system's points of ``kind`` (points without lines left out)."""
+def _point_nodes(model: Model, *kinds: str) -> np.ndarray:
+    """The first line end's node of each of a system's points of these ``kinds`` (points without lines left
+    out)."""
     from ..model.layout import point_ends
 
     ends = point_ends(model.scene, model.lines)
-    return np.array([ends[p.id][0] for p in model.scene.points if p.kind == kind and ends[p.id]], dtype=np.int64)
+    return np.array([ends[p.id][0] for p in model.scene.points if p.kind in kinds and ends[p.id]], dtype=np.int64)
 
 
 def _system_marks(model: Model) -> list[Mark]:

@@ -15,7 +15,7 @@ from typing import Any
 from . import schema as S
 from .builtin import resolve
 from .errors import SceneError
-from .material import agree, mass_per_length, per_node
+from .material import agree, mass_per_length, per_node, resolve_axial_damping
 from .motion import complete_motion
 from .system import (POINT_BODY_IN_A_SYSTEM, RIGID_BODY_IN_A_ROPE, ROPE_ONLY_INSTEAD, SYSTEM_ONLY_INSTEAD,
                      resolve_system)
@@ -46,8 +46,27 @@ def load_scene(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) ->
         raise SceneError(source, "", "is a folder, not a scene file") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise SceneError(source, "", f"cannot be read ({exc.__class__.__name__})") from None
+    if path.suffix.lower() != ".toml":
+        from .moordyn import looks_like_moordyn
+
+        if looks_like_moordyn(text):
+            return scene_from_moordyn(text, source=source, default_name=path.stem, overrides=overrides,
+                                      base_dir=path.resolve().parent)
     return scene_from_toml(text, source=source, default_name=path.stem, overrides=overrides,
                            base_dir=path.resolve().parent)
+
+
+def scene_from_moordyn(text: str, source: str = "<moordyn>", default_name: str = "scene",
+                       overrides: list[str] | tuple[str, ...] = (), base_dir: str | Path | None = None) -> S.Scene:
+    """The scene of a MoorDyn v2 input file's text (:mod:`ropesim.scene.moordyn`; what it leaves out is in
+    ``read_moordyn(text).notes``), with ``--set`` style overrides applied; raises :class:`SceneError`."""
+    from .moordyn import read_moordyn
+
+    raw = {"name": default_name, **read_moordyn(text, source).scene}
+    for item in overrides:
+        apply_override(raw, item, source)
+    label = f"{source} (imported from MoorDyn{', with --set ' + ' '.join(overrides) if overrides else ''})"
+    return scene_from_dict(raw, source=label, default_name=default_name, base_dir=base_dir)
 
 
 def scene_from_toml(text: str, source: str = "<scene>", default_name: str = "scene",
@@ -346,7 +365,7 @@ def _check_seabed(scene: S.Scene, fail) -> None:
             fail("seabed.contact_width", f"missing: the seabed pushes on a footprint contact_width x node length; "
                                          f"give it, or every line's diameter (lines.{bare[0]} has none)")
         held = [(f"{p.kind} point '{p.id}' (points.{j}, at y = {p.position[1]:.6g} m)", p.position[0], p.position[1])
-                for j, p in enumerate(scene.points) if p.kind in ("fixed", "driven")]
+                for j, p in enumerate(scene.points) if p.kind in (*S.STILL_KINDS, "driven")]
     else:
         if bed.contact_width is None and scene.rope.diameter is None:
             fail("seabed.contact_width", "missing: the seabed pushes on a footprint contact_width x node length; "
@@ -381,7 +400,11 @@ def _resolve_rope(rope: S.Rope, source: str) -> S.Rope:
                 spec = {f.name: f.metadata["spec"] for f in fields(S.Rope)}[key]
                 fail(key, f"missing: {spec.doc}{unit_of(spec)}; or give the rope in physical units (length, "
                           f"segments, mass_per_length, EA)")
-        return replace(rope, compression=True if rope.compression is None else rope.compression)
+        l0 = rope.segment_length
+        damping = resolve_axial_damping(rope.axial_damping, rope.axial_damping_ratio, l0, rope.stiffness * l0,
+                                        rope.mass / l0, fail)
+        return replace(rope, compression=True if rope.compression is None else rope.compression,
+                       axial_damping=damping)
     for key in ("length", "EA"):
         if getattr(rope, key) is None:
             fail(key, f"missing: a rope in physical units needs length, EA, segments (or nodes) and "
@@ -405,7 +428,9 @@ def _resolve_rope(rope: S.Rope, source: str) -> S.Rope:
         if given is not None and not agree(given, value):
             fail(key, f"{given:g} contradicts the physical form, which gives {value:g}; give one form, or both "
                       f"consistently")
-    return replace(rope, segments=segments, mass_per_length=per_metre,
+    damping = resolve_axial_damping(rope.axial_damping, rope.axial_damping_ratio, derived["segment_length"],
+                                    rope.EA, per_metre, fail)
+    return replace(rope, segments=segments, mass_per_length=per_metre, axial_damping=damping,
                    compression=False if rope.compression is None else rope.compression, **derived)
 
 

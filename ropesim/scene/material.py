@@ -33,6 +33,27 @@ def mass_per_length(given: float | None, diameter: float | None, density: float 
     return per_metre
 
 
+def axial_damping_of_ratio(ratio: float, segment_length: float, EA: float, per_metre: float) -> float:
+    """The axial damping BA [N s] that damps a segment's stretching at ``ratio`` times critical: MoorDyn's negative
+    BA, BA = zeta l sqrt(EA m') (Line.cpp). A segment of length l between two free nodes of mass m' l / 2 each
+    stretches with the reduced mass m' l / 4 on the spring EA / l, so its critical damping is 2 sqrt(EA / l m' l / 4)
+    = sqrt(EA m'), and the segment's damping BA / l is zeta times that."""
+    return ratio * segment_length * math.sqrt(EA * per_metre)
+
+
+def resolve_axial_damping(coefficient: float | None, ratio: float | None, segment_length: float, EA: float,
+                          per_metre: float, fail, where: str = "") -> float | None:
+    """The axial damping BA [N s] of a line given as a coefficient or a damping ratio (both only if they agree, as
+    in a resolved scene); ``fail(key, message)`` refuses."""
+    if ratio is None:
+        return coefficient
+    from_ratio = axial_damping_of_ratio(ratio, segment_length, EA, per_metre)
+    if coefficient is not None and not agree(coefficient, from_ratio):
+        fail("axial_damping", f"{coefficient:g} N s contradicts axial_damping_ratio = {ratio:g}, which gives "
+                              f"zeta l sqrt(EA m') = {from_ratio:g} N s; give one of them{where}")
+    return from_ratio
+
+
 PER_NODE = {   # derived per-node value: (the physical key it comes from, how, unit)
     "segment_length": ("length", "length / segments", "m"),
     "stiffness": ("EA", "EA / l", "N/m"),

@@ -66,7 +66,10 @@ class Rope:
       touches, so an open line's two end nodes carry half a segment (MoorDyn's convention). The resolved
       scene shows both forms.
 
-    ``axial_damping`` (BA) adds a force BA (dl/dt) / l along each segment, in tension and compression.
+    ``axial_damping`` (BA) adds a force BA (dl/dt) / l along each segment, in tension and compression; or give
+    ``axial_damping_ratio`` zeta, a fraction of each segment's critical damping (MoorDyn's negative BA): BA = zeta
+    l sqrt(EA m'), since a segment between two nodes of m' l / 2 stretches with critical damping sqrt(EA m') (per
+    node, EA = k l and m' = m / l). The resolved scene shows both.
     ``EI`` gives the rope bending stiffness: each joint between segments stores EI (1 - cos theta) / l_j, theta
     the angle between the two segments and l_j the mean of their rest lengths (EI kappa^2 / 2 per length for
     small angles, kappa = theta / l_j); the forces are that energy's gradient.
@@ -98,6 +101,9 @@ class Rope:
                             open_low=True)
     axial_damping: float | None = spec("float", "internal damping BA: force BA (dl/dt) / l along each segment",
                                        "N s", default=None, required=False, low=0)
+    axial_damping_ratio: float | None = spec("float", "internal damping as a fraction zeta of each segment's "
+                                                      "critical damping (MoorDyn's negative BA): BA = zeta l "
+                                                      "sqrt(EA m')", default=None, required=False, low=0)
     EI: float | None = spec("float", "bending stiffness EI: energy EI (1 - cos theta) / l at each joint",
                             "N m^2", default=None, required=False, low=0, open_low=True)
     compression: bool | None = spec("bool", "segments push back when shorter than their rest length (default: "
@@ -282,7 +288,8 @@ class LineType:
     """A line material, named under ``[line_types.NAME]`` and used by ``[[lines]]`` through ``type = "NAME"``:
     the physical form of ``[rope]`` (diameter, mass per metre or density, EA, axial damping BA, EI), and the
     fluid coefficients of lines of this type where they differ from the scene's ``[fluid_drag]`` and
-    ``[added_mass]`` (MoorDyn's line types carry Cd, Ca, CdAx and CaAx)."""
+    ``[added_mass]`` (MoorDyn's line types carry Cd, Ca, CdAx and CaAx). ``axial_damping_ratio`` (as ``[rope]``'s)
+    gives each line of this type the BA of its own segment length."""
 
     diameter: float | None = spec("float", "diameter d: the area drag, buoyancy and added mass act on", "m",
                                   default=None, required=False, low=0, open_low=True)
@@ -293,6 +300,9 @@ class LineType:
     EA: float | None = spec("float", "axial stiffness EA", "N", default=None, required=False, low=0, open_low=True)
     axial_damping: float | None = spec("float", "internal damping BA: force BA (dl/dt) / l along each segment",
                                        "N s", default=None, required=False, low=0)
+    axial_damping_ratio: float | None = spec("float", "internal damping as a fraction zeta of each segment's "
+                                                      "critical damping (MoorDyn's negative BA): BA = zeta l "
+                                                      "sqrt(EA m')", default=None, required=False, low=0)
     EI: float | None = spec("float", "bending stiffness EI: energy EI (1 - cos theta) / l at each joint",
                             "N m^2", default=None, required=False, low=0, open_low=True)
     compression: bool | None = spec("bool", "segments push back when shorter than their rest length (default "
@@ -333,6 +343,9 @@ class Line:
     EA: float | None = spec("float", "axial stiffness EA", "N", default=None, required=False, low=0, open_low=True)
     axial_damping: float | None = spec("float", "internal damping BA: force BA (dl/dt) / l along each segment",
                                        "N s", default=None, required=False, low=0)
+    axial_damping_ratio: float | None = spec("float", "internal damping as a fraction zeta of each segment's "
+                                                      "critical damping (MoorDyn's negative BA): BA = zeta l "
+                                                      "sqrt(EA m')", default=None, required=False, low=0)
     EI: float | None = spec("float", "bending stiffness EI: energy EI (1 - cos theta) / l at each joint",
                             "N m^2", default=None, required=False, low=0, open_low=True)
     compression: bool | None = spec("bool", "segments push back when shorter than their rest length (default "
@@ -355,7 +368,11 @@ class Line:
         return self.length / self.segments
 
 
-POINT_KINDS = ("fixed", "free", "driven", "body")
+POINT_KINDS = ("fixed", "free", "driven", "body", "coupled")
+STILL_KINDS = ("fixed", "coupled")
+"""The kinds of point and body that stay where the scene puts them in a plain run: ``coupled`` ones are moved by a
+program ropesim is coupled to (MoorDyn's Coupled or Vessel points and bodies); a run of the scene alone holds them
+still at their initial positions, as fixed ones."""
 
 
 @dataclass(frozen=True)
@@ -363,15 +380,16 @@ class Point:
     """A point of a system, where line ends meet: ``fixed`` (an anchor), ``free`` (a connector, a clump weight,
     a buoy: it moves under the pull of its lines, its weight less buoyancy, its drag -1/2 rho CdA |u| u on the
     velocity u relative to the flow, with added mass rho Ca V, MoorDyn's free point), ``driven`` (moved along a
-    prescribed path: the motion keys of ``[[driven]]``, exactly at every stage) or ``body`` (fixed on rigid body
-    ``body`` at ``position`` in the body's frame, a fairlead). Every line end on a point moves with it, and its
+    prescribed path: the motion keys of ``[[driven]]``, exactly at every stage), ``body`` (fixed on rigid body
+    ``body`` at ``position`` in the body's frame, a fairlead) or ``coupled`` (moved by a program ropesim is coupled
+    to, MoorDyn's Coupled or Vessel point; a run of the scene alone holds it where it starts, as a fixed one). Every line end on a point moves with it, and its
     node's mass (half a segment) joins the point's."""
 
     id: str = spec("str", "the point's name, which lines name as their start or end")
     position: tuple = spec("vector", "position (of a body's point: in the body's frame, from its reference "
                                      "point)", "m")
-    kind: str | None = spec("str", "fixed, free, driven, or body (default: body when a body is named, else "
-                                   "fixed)", default=None, required=False, choices=POINT_KINDS)
+    kind: str | None = spec("str", "fixed, free, driven, body or coupled (default: body when a body is named, "
+                                   "else fixed)", default=None, required=False, choices=POINT_KINDS)
     body: str | None = spec("str", "the rigid body it is fixed on (kind = body)", default=None, required=False)
     mass: float | None = spec("float", "free point: its own mass (a clump weight, a connector)", "kg", default=None,
                               required=False, low=0)
@@ -399,7 +417,7 @@ class Point:
         return self.amplitude is not None or self.path is not None or self.path_table is not None
 
 
-BODY_KINDS = ("free", "fixed", "driven")
+BODY_KINDS = ("free", "fixed", "driven", "coupled")
 
 
 @dataclass(frozen=True)
@@ -415,11 +433,13 @@ class RigidBody:
     body's axes at the reference point (MoorDyn's body conventions). Lines attach through points with
     ``body = this id``. ``free``: it moves under every force, by the Newton-Euler equations (the gyroscopic
     moment w x I w included); ``fixed``: it stays; ``driven``: it follows a prescribed motion, a constant
-    velocity and rotation rate plus a sinusoid and a path per degree of freedom."""
+    velocity and rotation rate plus a sinusoid and a path per degree of freedom; ``coupled``: moved by a program
+    ropesim is coupled to (MoorDyn's Coupled or Vessel body), held where it starts in a run of the scene alone."""
 
     id: str = spec("str", "the body's name, which points name to sit on it")
     position: tuple = spec("vector", "its reference point (the origin of its frame) at t = 0", "m")
-    kind: str = spec("str", "free, fixed or driven", default="free", choices=BODY_KINDS)
+    kind: str = spec("str", "free, fixed, driven or coupled (held where it starts in a run of the scene alone)",
+                     default="free", choices=BODY_KINDS)
     orientation: tuple | None = spec("angles", "its orientation at t = 0: rotations about x, y, z (3-D) or about z "
                                                "(2-D)", "deg", default=None, required=False)
     mass: float = spec("float", "its mass", "kg", default=0.0, low=0)

@@ -16,7 +16,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from . import schema as S
-from .material import mass_per_length, per_node
+from .material import mass_per_length, per_node, resolve_axial_damping
 from .motion import complete_motion
 from .values import MIN_POSITIVE, check_name, count_of, dof_labels, show
 
@@ -121,6 +121,7 @@ def _resolve_line(scene: S.Scene, i: int, line: S.Line, fail) -> S.Line:
     per_metre = mass_per_length(material["mass_per_length"], material["diameter"], material["density"], fail_line,
                                 given_in)
     per_node(line.length, line.segments, material["EA"], per_metre, fail_line)
+    material["axial_damping"] = _line_damping(line, kind, material, per_metre, key, fail)
     for k, table in FLUID_COEFFICIENTS.items():
         part = getattr(scene, table)
         if part is None and material[k] is not None:
@@ -129,6 +130,19 @@ def _resolve_line(scene: S.Scene, i: int, line: S.Line, fail) -> S.Line:
             material[k] = getattr(part, k)
     material.update(mass_per_length=per_metre, compression=bool(material["compression"]))
     return replace(line, **material)
+
+
+def _line_damping(line: S.Line, kind: S.LineType | None, material: dict, per_metre: float, key: str, fail):
+    """The line's axial damping BA [N s], from a coefficient or a damping ratio: the line's own key wins over its
+    type's (a type's ratio gives each line the coefficient of its own segment length)."""
+    own = [k for k in ("axial_damping", "axial_damping_ratio") if getattr(line, k) is not None]
+    source, where = (line, key) if own or kind is None else (kind, f"line_types.{line.type}")
+    coefficient, ratio = source.axial_damping, source.axial_damping_ratio
+    if own == ["axial_damping"]:
+        ratio = None
+    material["axial_damping_ratio"] = ratio
+    return resolve_axial_damping(coefficient, ratio, line.segment_length, material["EA"], per_metre,
+                                 lambda k, message: fail(f"{where}.{k}", message))
 
 
 # ------------------------------------------------------------------------------------------ points
@@ -168,6 +182,7 @@ def _resolve_point(scene: S.Scene, j: int, point: S.Point, base_dir: Path, fail)
 
 def _held_by(kind: str) -> str:
     return {"fixed": "it stays where it is, whatever acts on it",
+            "coupled": "the program it is coupled to moves it (a run of the scene alone holds it still)",
             "driven": "it follows its prescribed motion, whatever acts on it",
             "body": "it moves with its body (give the body its mass, volume and drag)"}[kind]
 

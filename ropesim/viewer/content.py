@@ -32,6 +32,8 @@ from typing import Protocol
 
 import numpy as np
 
+from ..scene.schema import STILL_KINDS
+
 
 class FrameArray(Protocol):
     """A per-frame array, read lazily: ``a[frame_indices]`` is an ndarray with the frames on axis 0."""
@@ -306,7 +308,7 @@ def _rigid_bodies(traj) -> list[Body]:
         side = np.maximum(hi - lo, MIN_SIDE * float(np.max(hi - lo)) or 1.0)
         size = tuple(float(v) for v in side) + ((0.0,) if dim == 2 else ())
         out.append(Body(body.id, size, BoxCentre(traj, b, (lo + hi) / 2), traj.body_q[:, b],
-                        fixed=body.kind == "fixed", color=BODY_CSS))
+                        fixed=body.kind in STILL_KINDS, color=BODY_CSS))
     return out
 
 
