@@ -50,7 +50,6 @@ import numpy as np
 
 from . import jit
 from .forces.fluid import WITH_FLOW, flow_at, node_tangent
-from ..scene.schema import STILL_KINDS
 from .rotation import cross, matrix_of, quaternion_from_angles, rotate, rotate_back, turn
 
 WITH_BODIES = jit.Switch("bodies", "free rigid bodies")
@@ -487,7 +486,7 @@ def body_frames(model, t: np.ndarray, state: np.ndarray | None) -> dict[str, np.
             out["body_q"][:, b] = rows[:, 3:7]
             out["body_v"][:, b] = rows[:, POSE:POSE + dim]
             out["body_w"][:, b] = rows[:, POSE + 3:POSE + 6]
-        elif body.kind in STILL_KINDS:
+        elif body.kind == "fixed":   # a coupled body moves as its coupling moves it (held still in a plain run)
             pose = initial_pose(body, dim)
             out["body_x"][:, b] = pose[:dim]
             out["body_q"][:, b] = pose[3:]
@@ -506,7 +505,7 @@ def driven_pose(model, body, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.
     from .motion import rigid_state
     from .rotation import quaternion_from_matrix
 
-    driven = [b for b in model.scene.rigid_bodies if b.kind == "driven"]
+    driven = [b for b in model.scene.rigid_bodies if b.kind in ("driven", "coupled")]
     index = driven.index(body)
     motions = model.motion.bodies
     state = np.array([rigid_state(motions, index, float(tk), float(tk)) for tk in t]).reshape(len(t), 24)

@@ -172,7 +172,9 @@ def _resolve_point(scene: S.Scene, j: int, point: S.Point, base_dir: Path, fail)
     if kind != "driven":
         given = [k for k in (*MOTION_KEYS, "ramp_time") if getattr(point, k) is not None]
         if given:
-            instead = "drive its body instead" if kind == "body" else "set kind = 'driven' to move it so"
+            instead = ("drive its body instead" if kind == "body" else
+                       "the coupled program gives its motion at every step" if kind == "coupled" else
+                       "set kind = 'driven' to move it so")
             fail(f"{key}.{given[0]}", f"is a driven point's motion; this point is '{kind}' ({instead})")
         return replace(point, kind=kind)
     labels = ("dx", "dy", "dz")[: scene.dimension]
