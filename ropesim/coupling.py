@@ -42,6 +42,7 @@ import numpy as np
 from .integrate.grid import TimeGrid
 from .integrate.health import E0, OK
 from .model.build import Model, build
+from .model.jit import Direct
 
 BODY_ROWS = {3: (0, 1, 2, 3, 4, 5), 2: (0, 1, 5)}   # a body's degrees of freedom among a driven body's six rows
 STEP_TOLERANCE = 1e-9                              # relative: a coupling step is a whole number of internal steps
@@ -93,6 +94,18 @@ def coupled_objects(model: Model) -> tuple[CoupledObject, ...]:
     return tuple(out)
 
 
+def objects_bundle(objects: tuple[CoupledObject, ...], dim: int):
+    """The coupled objects as the compiled ends of a step take them (:class:`ropesim.model.coupled.Objects`)."""
+    from .model.coupled import BODY, POINT, Objects
+
+    starts = np.cumsum([0] + [len(o.rows) for o in objects])
+    return Objects(np.array([POINT if o.kind == "point" else BODY for o in objects], dtype=np.int64),
+                   np.array([o.first for o in objects], dtype=np.int64),
+                   np.array([o.body for o in objects], dtype=np.int64), starts.astype(np.int64),
+                   np.array([j for o in objects for j in o.rows], dtype=np.int64),
+                   np.array(BODY_ROWS[dim], dtype=np.int64))
+
+
 class Coupling:
     """A system advanced one coupling step at a time by another program (see the module doc).
 
@@ -125,9 +138,9 @@ class Coupling:
         self.integrator = None
         self.writer = None
         self._rows = None
-        self._forces = None
+        self._begin_step = self._end = self._no_frames = None
+        self._objects = objects_bundle(self.objects, self.model.dim)
         self._acc = np.zeros((self.model.dim, self.model.nodes))
-        self._coupled_rows = np.array(sorted(j for o in self.objects for j in o.rows), dtype=np.int64)
         self.wall_time = 0.0
 
     # -- what the caller asks ------------------------------------------------------------------------------
@@ -167,9 +180,11 @@ class Coupling:
             raise CouplingError(f"{self.scene.name}: init() was called already; make a new Coupling to start again")
         x = self._checked(self.positions() if positions is None else positions, "positions")
         v = self._checked(np.zeros(self.dofs) if velocities is None else velocities, "velocities")
+        from .model.motion import Held
+
         model = self.model
-        self._set_motion(0.0, x, v, model.held_v)
-        self._place(model.x0, model.v0, 0.0, model.held_v)
+        motion = model.motion._replace(accel=model.motion.accel.copy())
+        self._begin(0.0, x, v, Held(model.held_idx, model.held_x0, model.held_v, motion), model.x0, model.v0)
         if statics:
             self._solve_statics()
         self._start(self.scene.integrator.dt)
@@ -280,17 +295,17 @@ class Coupling:
 
     def _checked(self, values, what: str) -> np.ndarray:
         try:
-            a = np.asarray(values, dtype=float)
+            a = np.array(values, dtype=np.float64)   # a fresh C-ordered copy: the compiled calls take no other
         except (TypeError, ValueError):
             raise CouplingError(f"{self.scene.name}: {what}: not an array of numbers ({type(values).__name__}); "
                                 f"give {self.dofs} numbers ({self.layout()})") from None
         if a.shape != (self.dofs,):
             raise CouplingError(f"{self.scene.name}: {what}: {a.size} numbers of shape {a.shape}; the coupled "
                                 f"objects have {self.dofs} degrees of freedom ({self.layout()})")
-        bad = np.flatnonzero(~np.isfinite(a))
-        if bad.size:
-            raise CouplingError(f"{self.scene.name}: {what}[{bad[0]}] = {float(a[bad[0]])!r} ({self._dof_name(bad[0])}); "
-                                f"every value must be a finite number")
+        if not np.isfinite(a).all():
+            k = int(np.flatnonzero(~np.isfinite(a))[0])
+            raise CouplingError(f"{self.scene.name}: {what}[{k}] = {float(a[k])!r} ({self._dof_name(k)}); every value "
+                                f"must be a finite number")
         return a
 
     def layout(self) -> str:
@@ -321,33 +336,15 @@ class Coupling:
         raise CouplingError(f"{self.scene.name}: step: dt = {dt!r} s is not a whole number of internal steps of "
                             f"{h!r} s (set by the first coupling step); give a multiple of it")
 
-    def _set_motion(self, t0: float, x: np.ndarray, v: np.ndarray, held_v: np.ndarray) -> None:
-        """Move every coupled object on x + v (t - t0) from time t0 (the loops' own time)."""
-        model, dim = self.model, self.model.dim
-        m = model.motion
-        for o in self.objects:
-            if o.kind == "point":
-                for j in o.rows:
-                    model.held_x0[:, j] = x[o.part] - v[o.part] * t0
-                    held_v[:, j] = v[o.part]
-                    m.base[:, j] = v[o.part]
-            else:
-                rows = BODY_ROWS[dim]
-                m.bodies.accel[rows, o.body] = x[o.part] - v[o.part] * t0
-                m.bodies.base[rows, o.body] = v[o.part]
+    def _begin(self, t0: float, x: np.ndarray, v: np.ndarray, held, state_x: np.ndarray,
+               state_v: np.ndarray) -> None:
+        """Move every coupled object on x + v (t - t0) from time t0 (the loops' own time) and place the held
+        nodes of ``state_x``, ``state_v`` there at t0 (:func:`ropesim.model.coupled.begin_step`)."""
+        if self._begin_step is None:
+            from .model.coupled import begin_step
 
-    def _place(self, x: np.ndarray, v: np.ndarray, t: float, held_v: np.ndarray) -> None:
-        """Every held node where its motion puts it at time t."""
-        model = self.model
-        idx = model.held_idx
-        if model.motion.moving:
-            from .model.motion import Held, place_moving
-
-            held = Held(idx, model.held_x0, held_v, model.motion._replace(accel=np.zeros_like(model.motion.accel)))
-            model.kernel(place_moving)(x, v, held, t, t)
-        else:
-            x[:, idx] = model.held_x0 + held_v * t
-            v[:, idx] = held_v
+            self._begin_step = Direct(self.model.kernel(begin_step))
+        self._begin_step(float(t0), x, v, self._objects, held, state_x, state_v)
 
     def _solve_statics(self) -> None:
         from .model.build import EquilibriumError
@@ -374,7 +371,9 @@ class Coupling:
         save_every = max(1, round(scene.output.interval / h))
         grid = TimeGrid(dt=h, steps=UNBOUNDED_STEPS, save_every=save_every, requested_dt=scene.integrator.dt)
         self.integrator = make_integrator(self.model, grid)
+        self._no_frames = None
         self.integrator.warm_up()
+        self.integrator.loop = Direct(self.integrator.loop)   # its arguments keep their types: no dispatch
         if self.folder is not None and self.writer is None:
             from .io.runfolder import RunWriter
             from .run import _manifest_info
@@ -403,11 +402,15 @@ class Coupling:
     def _advance(self, n: int, x: np.ndarray, v: np.ndarray) -> np.ndarray:
         i = self.integrator
         tick = time.perf_counter()
-        t0 = i.t
-        self._set_motion(t0, x, v, i.held.v)
-        self._place(i.x, i.v, t0, i.held.v)
-        frames = i.new_frames(n)
-        done, written, status, node = i.advance(n, frames)
+        self._begin(i.t, x, v, i.held, i.x, i.v)
+        if i.frames_in(n):
+            frames = i.new_frames(n)
+        else:                               # most coupling steps save no frame: the same empty buffers
+            if self._no_frames is None:
+                self._no_frames = i.new_frames(0)
+            frames = self._no_frames
+        done, written, status, node = i._run(n, frames)     # Integrator.advance, without its bundling
+        i.step += done
         if self.writer is not None and written:
             self.writer.append(self._rows(frames.t[:written], frames.x[:written], frames.v[:written],
                                           frames.ledger[:written], frames.body[:written]))
@@ -420,44 +423,16 @@ class Coupling:
         self.wall_time += time.perf_counter() - tick
         return forces
 
-    def held_forces(self) -> np.ndarray:
-        """The net force on every held node now, without its inertia (H, D) [N] (MoorDyn's report,
-        :func:`ropesim.model.tension.held_forces`)."""
-        from .model.tension import held_linear_drag
-        from .model.terms import accelerations
-
-        model, i = self.model, self.integrator
-        if self._forces is None:
-            self._forces = model.kernel(accelerations)
-        self._forces(i.x, i.v, self._acc, model.params, i.t)
-        idx = model.held_idx
-        net = model.mass[idx][:, None] * self._acc[:, idx].T
-        if np.any(model.drag[idx]):
-            net += held_linear_drag(model, i.t, i.x, i.v)
-        return net
-
     def _end_forces(self) -> np.ndarray:
-        """The forces and moments on the coupled objects now (see the module doc)."""
-        net = self.held_forces()
-        model, dim, i = self.model, self.model.dim, self.integrator
+        """The forces and moments on the coupled objects now (see the module doc;
+        :func:`ropesim.model.coupled.end_forces`)."""
+        model, i = self.model, self.integrator
+        if self._end is None:
+            from .model.coupled import end_forces
+
+            self._end = Direct(model.kernel(end_forces))
         out = np.zeros(self.dofs)
-        for o in self.objects:
-            rows = list(o.rows)
-            force = net[rows].sum(axis=0)
-            out[o.first:o.first + dim] = force
-            if o.kind == "point":
-                continue
-            m = model.motion.bodies
-            ref = m.accel[:dim, o.body] + m.base[:dim, o.body] * i.t
-            arm = i.x[:, model.held_idx[rows]] - ref[:, None]     # (D, K)
-            f = net[rows].T
-            mz = float(np.sum(arm[0] * f[1] - arm[1] * f[0]))
-            if dim == 2:
-                out[o.first + 2] = mz
-            else:
-                out[o.first + 3] = float(np.sum(arm[1] * f[2] - arm[2] * f[1]))
-                out[o.first + 4] = float(np.sum(arm[2] * f[0] - arm[0] * f[2]))
-                out[o.first + 5] = mz
+        self._end(i.x, i.v, self._acc, model.params, float(i.t), model.mass, self._objects, i.held, out)
         return out
 
     def _finish(self) -> None:
