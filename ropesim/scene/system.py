@@ -206,6 +206,13 @@ def _resolve_body(scene: S.Scene, j: int, body: S.RigidBody, base_dir: Path, fai
         if body.inertia is None:
             fail(f"{key}.inertia", "missing: a free body needs its moments of inertia about its centre of gravity "
                                    f"[kg m^2] ({'Ixx, Iyy, Izz' if dim == 3 else 'Izz'})")
+    if body.kind != "free":
+        for k in ("stiffness", "damping"):
+            if getattr(body, k) is not None:
+                fail(f"{key}.{k}", f"acts on a free body; this body is '{body.kind}' and does not move by its forces")
+    for k in ("stiffness", "damping"):
+        if getattr(body, k) is not None and min(getattr(body, k)) < 0:
+            fail(f"{key}.{k}", f"must be at least 0 along every axis, got {list(getattr(body, k))}")
     if body.kind == "free":   # its velocities at t = 0, at rest unless given
         body = replace(body, velocity=body.velocity if body.velocity is not None else zeros,
                        angular_velocity=body.angular_velocity if body.angular_velocity is not None else turns)
