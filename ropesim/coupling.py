@@ -208,6 +208,45 @@ class Coupling:
         n = self._internal_steps(float(dt))
         return self._advance(n, x, v)
 
+    def mass(self) -> np.ndarray:
+        """The mass matrix (dofs, dofs) [kg, kg m, kg m^2] of what the coupled objects carry now: their line ends'
+        lumped masses m_i and added masses a_n (I - q q^T) + a_t q q^T (q the node's tangent), a body's about its
+        reference point in world axes. The forces :meth:`step` returns leave this inertia out (MoorDyn's report);
+        a caller's model adds it to its own mass, as a free body inside ropesim carries its attachments'."""
+        model, i = self.model, self.integrator
+        if i is None:
+            raise CouplingError(f"{self.scene.name}: mass() before init()")
+        dim, x = model.dim, i.x
+        added = np.asarray(model.params.added_mass)
+        around = np.asarray(model.params.neighbours)
+        out = np.zeros((self.dofs, self.dofs))
+        for o in self.objects:
+            block = np.zeros((6, 6))
+            if o.kind == "body":
+                m = model.motion.bodies
+                ref = m.accel[:dim, o.body] + m.base[:dim, o.body] * i.t
+            for j in o.rows:
+                node = model.held_idx[j]
+                mi = model.mass[node] * np.eye(3)
+                if added.size:
+                    q = np.zeros(3)
+                    q[:dim] = x[:, around[1, node]] - x[:, around[0, node]]
+                    norm = np.linalg.norm(q)
+                    q = q / norm if norm > 0 else q
+                    a_n, a_t = added[0, node], added[1, node]
+                    mi = mi + a_n * (np.eye(3) - np.outer(q, q)) + a_t * np.outer(q, q)
+                arm = np.zeros(3)
+                if o.kind == "body":
+                    arm[:dim] = x[:, node] - ref
+                cross = np.array([[0, -arm[2], arm[1]], [arm[2], 0, -arm[0]], [-arm[1], arm[0], 0]])
+                block[:3, :3] += mi
+                block[:3, 3:] -= mi @ cross
+                block[3:, :3] += cross @ mi
+                block[3:, 3:] -= cross @ mi @ cross
+            keep = list(range(dim)) + ([3, 4, 5] if dim == 3 else [5]) if o.kind == "body" else list(range(dim))
+            out[o.part, o.part] = block[np.ix_(keep, keep)]
+        return out
+
     # -- state ---------------------------------------------------------------------------------------------
 
     COUPLING_STATE = ("coupling_held_x0", "coupling_held_v", "coupling_base", "coupling_body_pose0",
