@@ -157,8 +157,6 @@ class Coupling:
 
     def positions(self) -> np.ndarray:
         """The coupled objects' positions as the scene places them (the layout of :meth:`step`'s arrays)."""
-        from .model.bodies import initial_pose
-
         out = np.zeros(self.dofs)
         points = {p.id: p for p in self.scene.points}
         bodies = {b.id: b for b in self.scene.rigid_bodies}

@@ -165,3 +165,47 @@ def test_held_force_is_minus_the_support_on_a_fixed_anchor(driven_run):
     assert row.size == 1
     fairlead = driven_run.point("fairlead1")
     assert fairlead.held_force is not None and np.all(np.isfinite(fairlead.held_force))
+
+
+PLANAR = """
+name = "planar_chain"
+dimension = 2
+[[points]]
+id = "anchor"
+position = [0.0, -20.0]
+[[points]]
+id = "top"
+kind = "coupled"
+position = [15.0, 0.0]
+[[lines]]
+id = "chain"
+start = "anchor"
+end = "top"
+length = 30.0
+segments = 12
+mass_per_length = 2.0
+EA = 1.0e5
+axial_damping = 200.0
+[gravity]
+g = 9.81
+[integrator]
+method = "verlet"
+dt = 0.001
+t_end = 1.0
+[output]
+interval = 0.1
+"""
+
+
+def test_a_planar_coupled_point_held_still_pulls_as_the_run_that_holds_it():
+    scene = ropesim.scene_from_toml(PLANAR, source="planar.toml")
+    run = ropesim.simulate(scene)
+    coupling = ropesim.Coupling(scene)
+    assert coupling.layout() == "top: x y"
+    coupling.init(statics=False)
+    for k in range(10):
+        forces = coupling.step(0.1 * k, 0.1, [15.0, 0.0], [0.0, 0.0])
+    held = run.point("top").held_force[-1]
+    assert np.allclose(forces, held, rtol=1e-9, atol=1e-9)
+    assert np.allclose(run.x[-1], coupling.integrator.x.T, rtol=0, atol=1e-12)
+    assert held[1] < 0 and held[0] < 0        # the chain hangs down towards its anchor, below and to the left
