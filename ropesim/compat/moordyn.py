@@ -18,8 +18,8 @@ coordinates are turned: MoorDyn's (x, y, z) is the scene's (x, z, -y). Calls run
 
 A coupled body's angles are MoorDyn's (roll, pitch, yaw, R = Rx Ry Rz, ``Euler2Quat``) and its angular
 velocity the world-axes one MoorDyn moves its points with; both are turned into the scene's angles (R = Rz Ry
-Rx) and their rates at every step, and the scene's angles move linearly over the step, MoorDyn's own angles
-do: the two paths agree to second order in the rotation over one coupling step.
+Rx) and their rates at every step; the scene's angles then move linearly over the step where MoorDyn's own
+angles do, two paths that agree to second order in the rotation over one coupling step.
 
 Not supported, one line each (a call raises :class:`NotImplementedError` saying so):
 
