@@ -22,7 +22,7 @@ from .io.numba_cache import ensure_writable_cache  # noqa: E402
 ensure_writable_cache()  # before any kernel is defined: a read-only install caches its kernels elsewhere
 
 __all__ = ["load_scene", "scene_from_toml", "SceneError", "Scene", "simulate", "Trajectory", "RunFolderError",
-           "METHODS", "scene_to_toml", "view"]
+           "METHODS", "scene_to_toml", "view", "Coupling", "CouplingError"]
 
 _LAZY = {
     "load_scene": "scene.loader", "scene_from_toml": "scene.loader", "SceneError": "scene.loader",
@@ -31,6 +31,7 @@ _LAZY = {
     "Trajectory": "io.trajectory", "RunFolderError": "io.trajectory",
     "METHODS": "integrate.methods",
     "view": "viewer.page",
+    "Coupling": "coupling", "CouplingError": "coupling",
 }
 
 

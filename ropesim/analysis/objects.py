@@ -195,7 +195,11 @@ class PointResults:
     - ``ends``: the line ends on it, (line id, "start" or "end"); ``nodes`` their nodes in the trajectory;
     - ``line_forces``: {line id: (F, D) [N]}, the force each line puts on the point (both its ends, if it has
       two here); ``force`` (F, D) [N] their sum. On a fixed or driven point the support holds against it; on a
-      free point it balances the point's weight, drag and inertia.
+      free point it balances the point's weight, drag and inertia;
+    - ``held_force`` (F, D) [N]: on a held point (fixed, driven, coupled, or on a body that is not free) the net
+      force on its line ends' nodes without their inertia, as MoorDyn reports a point's force
+      (``Point::getFnet``): the lines' pull plus the weight, buoyancy, drag and seabed push on the half
+      segments the point carries (None on a free point, or for a run folder written before ropesim stored it).
     """
 
     def __init__(self, traj, point, lines: dict[str, LineResults]):
@@ -232,6 +236,24 @@ class PointResults:
         for force in self.line_forces.values():
             total = total + force
         return total
+
+    @cached_property
+    def held_force(self) -> np.ndarray | None:
+        stored = self.traj.held_force
+        if stored is None:
+            return None
+        held = held_rows(self.traj.scene)
+        if any(node not in held for node in self.nodes):
+            return None
+        return sum(np.asarray(stored[:, held[node]]) for node in self.nodes)
+
+
+def held_rows(scene) -> dict[int, int]:
+    """{node: its row in the support and held_force arrays} of a system's held nodes, as the model orders them."""
+    from ..model.build import build
+
+    model = build(scene, solve=False)
+    return {int(node): j for j, node in enumerate(model.held_idx)}
 
 
 def point_results(traj, id: str) -> PointResults:

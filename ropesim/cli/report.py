@@ -292,6 +292,8 @@ def _body_text(body, scene: Scene) -> str:
         ramp = f", ramped in over {body.ramp_time:g} s" if body.ramp_time and (axes or body.path_table is not None) \
             else ""
         text += "; " + (" + ".join(moves) + ramp if moves else "held still (every amplitude is 0)")
+    if body.kind == "coupled":
+        text += "; moved through ropesim.Coupling (held where the scene puts it by ropesim run)"
     return text
 
 

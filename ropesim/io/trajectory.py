@@ -21,7 +21,7 @@ from .frames import check_run_folder, read_run
 from .runfolder import SCENE, TRAJECTORY, RunFolderError
 
 ARRAYS = ("t", "x", "v")
-DERIVED = ("tension", "strain", "support", "body_x", "body_q", "body_v", "body_w")
+DERIVED = ("tension", "strain", "support", "held_force", "body_x", "body_q", "body_v", "body_w")
 """Per frame, derived from t, x and v (and the free bodies' states) as they are stored."""
 BODY_STATE = ("body_x", "body_v", "body_q", "body_w")   # a system's rigid bodies, in the scene's order
 
@@ -90,7 +90,8 @@ def scene_nodes(scene) -> int:
 class Trajectory:
     """Saved frames of one run: ``t`` (F,) [s], ``x`` and ``v`` (F, N, D) [m, m/s], each segment's ``tension``
     [N] and ``strain`` (F, S), the force each support exerts on its held node, ``support`` (F, H, D) [N] (None
-    without held nodes), the energy ledger's flows ``ledger`` (F, C) [J] (columns
+    without held nodes), the net force on each held node without its inertia, ``held_force`` (F, H, D) [N]
+    (MoorDyn's report for a fixed or coupled point: :mod:`ropesim.model.tension`), the energy ledger's flows ``ledger`` (F, C) [J] (columns
     :data:`ropesim.integrate.health.LEDGER_COLUMNS`), with its scene and summary (the derived arrays and
     ``ledger`` are None for a run folder written before ropesim stored them).
 
@@ -112,6 +113,7 @@ class Trajectory:
     tension: np.ndarray | None = None
     strain: np.ndarray | None = None
     support: np.ndarray | None = None
+    held_force: np.ndarray | None = None   # (F, H, D) the net force on each held node without its inertia [N]
     ledger: np.ndarray | None = None   # (F, C) the energy ledger's cumulative flows [J], columns LEDGER_COLUMNS
     body_x: np.ndarray | None = None   # (F, B, D) each rigid body's reference point [m] (None without bodies)
     body_q: np.ndarray | None = None   # (F, B, 4) its orientation, a unit quaternion (w, x, y, z), body to world

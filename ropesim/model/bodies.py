@@ -56,7 +56,7 @@ from .rotation import cross, matrix_of, quaternion_from_angles, rotate, rotate_b
 WITH_BODIES = jit.Switch("bodies", "free rigid bodies")
 
 Bodies = namedtuple("Bodies", ["mass", "cog", "inertia", "lift", "cob", "drag", "drag_rot", "added", "added_rot",
-                               "start", "nodes", "arm", "node_added", "work"])
+                               "spring", "damper", "rest", "start", "nodes", "arm", "node_added", "work"])
 
 POSE, TWIST = 7, 6   # rows of the pose (r, q) and twist (v, w) arrays
 STATE_ROWS = POSE + TWIST   # a saved frame's rows per body
@@ -124,7 +124,8 @@ def bodies_bundle(scene, ends: dict[str, list[int]], added: np.ndarray) -> Bodie
     rho = scene.fluid.density if scene.fluid is not None else 0.0
     g = scene.gravity.g if scene.gravity is not None else 0.0
     count = len(bodies)
-    out = {name: np.zeros((3, count)) for name in ("cog", "cob", "drag", "drag_rot", "added", "added_rot")}
+    out = {name: np.zeros((3, count)) for name in ("cog", "cob", "drag", "drag_rot", "added", "added_rot", "spring",
+                                                   "damper", "rest")}
     mass, lift, inertia = np.zeros(count), np.zeros(count), np.zeros((3, 3, count))
     start, nodes, arms = np.zeros(count + 1, dtype=np.int64), [], []
     on_body = attachments(scene, ends)
@@ -138,6 +139,9 @@ def bodies_bundle(scene, ends: dict[str, list[int]], added: np.ndarray) -> Bodie
         out["drag_rot"][:, b] = 0.5 * rho * turns3(body.cd_rotation, dim)
         out["added"][:, b] = vector3(body.added_mass, dim)
         out["added_rot"][:, b] = turns3(body.added_inertia, dim)
+        out["spring"][:, b] = vector3(body.stiffness or (0.0,) * dim, dim)
+        out["damper"][:, b] = vector3(body.damping or (0.0,) * dim, dim)
+        out["rest"][:, b] = vector3(body.position, dim)
         for node, arm in on_body[body.id]:
             nodes.append(node)
             arms.append(arm)
@@ -149,7 +153,8 @@ def bodies_bundle(scene, ends: dict[str, list[int]], added: np.ndarray) -> Bodie
         added[:, node_index] = 0.0
     arm = np.array(arms, dtype=float).T.copy() if arms else np.zeros((3, 0))
     return Bodies(mass, out["cog"], inertia, lift, out["cob"], out["drag"], out["drag_rot"], out["added"],
-                  out["added_rot"], start, node_index, arm, node_added, np.zeros((6, 7)))
+                  out["added_rot"], out["spring"], out["damper"], out["rest"], start, node_index, arm, node_added,
+                  np.zeros((6, 7)))
 
 
 def no_bodies() -> None:
@@ -174,7 +179,9 @@ def body_energy_numpy(bundle: Bodies, pose: np.ndarray, twist: np.ndarray, g: fl
     kinetic = 0.5 * (bundle.mass * np.einsum("...bi,...bi->...b", v_g, v_g)
                      + np.einsum("...bi,...bij,...bj->...b", w, inertia, w))
     y = pose[..., 1, :]
-    return {"body kinetic": kinetic.sum(axis=-1),
+    stretch = pose[..., 0:3, :] - bundle.rest
+    out = {"body spring": 0.5 * (bundle.spring * stretch * stretch).sum(axis=(-2, -1))} if np.any(bundle.spring) else {}
+    return {**out, "body kinetic": kinetic.sum(axis=-1),
             "body gravity": (bundle.mass * g * (y + c[..., 1])).sum(axis=-1),
             "body buoyancy": (-bundle.lift * (y + cb[..., 1])).sum(axis=-1)}
 
@@ -347,6 +354,11 @@ def body_own_system(work, gravity, flow, bodies, pose, twist, b, t, power):
             work[i, 6] += r[3 * i + k] * fb
             work[3 + i, 6] += r[3 * i + k] * tb
             power += r[3 * i + k] * (fb * twist[i, b] + tb * twist[3 + i, b])
+    # the linear spring and damper on the reference point (no moment about it); the damper's power is the fluid's
+    for k in range(3):
+        damping = bodies.damper[k, b] * twist[k, b]
+        work[k, 6] -= bodies.spring[k, b] * (pose[k, b] - bodies.rest[k, b]) + damping
+        power -= damping * twist[k, b]
     return power
 
 
@@ -455,6 +467,9 @@ def body_energy(bodies, pose, twist, gravity):
         k1 = rotate(r, bodies.cob[0, b], bodies.cob[1, b], bodies.cob[2, b])[1]
         e += 0.5 * m * (g0 * g0 + g1 * g1 + g2 * g2) + 0.5 * spin + m * gravity * (pose[1, b] + c1)
         e -= bodies.lift[b] * (pose[1, b] + k1)
+        for k in range(3):
+            stretch = pose[k, b] - bodies.rest[k, b]
+            e += 0.5 * bodies.spring[k, b] * stretch * stretch
     return e
 
 
@@ -531,7 +546,7 @@ def driven_pose(model, body, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.
     from .motion import rigid_state
     from .rotation import quaternion_from_matrix
 
-    driven = [b for b in model.scene.rigid_bodies if b.kind == "driven"]
+    driven = [b for b in model.scene.rigid_bodies if b.kind in ("driven", "coupled")]
     index = driven.index(body)
     motions = model.motion.bodies
     state = np.array([rigid_state(motions, index, float(tk), float(tk)) for tk in t]).reshape(len(t), 24)

@@ -159,7 +159,8 @@ class StaticBodies:
             self.total[b] = self.own_rhs[b]
             self.total[b, :3] += pulls.sum(axis=0)
             self.total[b, 3:] += _cross(arms, pulls).sum(axis=0)
-            self.drag[b, :3] -= weight + lift
+            spring = -bundle.spring[:, b] * (pose[:3, b] - bundle.rest[:, b])   # a free body's linear spring
+            self.drag[b, :3] -= weight + lift + spring
             self.drag[b, 3:] -= _cross(c, weight) + _cross(cb, lift)
             self.stiffness[b] = rotational_stiffness(np.vstack([pulls, weight, lift]), np.vstack([arms, c, cb]))
 
@@ -183,6 +184,7 @@ class StaticBodies:
         for b in range(self.count):
             block = self.matrix[b].copy()
             block[3:, 3:] += tau * tau * self.stiffness[b]
+            block[:3, :3] += tau * tau * np.diag(self.bundle.spring[:, b])
             at = self.offset + b * k
             groups.own[at:at + k, at:at + k] = block[np.ix_(keep, keep)]
             groups.own_rhs[at:at + k] = tau * tau * self.own_rhs[b, keep]
@@ -197,12 +199,14 @@ class StaticBodies:
 
     def energy(self, pose: np.ndarray) -> float:
         """The bodies' potential energy [J]: weight at the centre of gravity, buoyancy at the centre of
-        buoyancy."""
+        buoyancy, a linear spring's stretch."""
         bundle = self.bundle
         turned = _matrices(pose[3:7])
         c = np.einsum("bij,jb->b", turned[:, 1:2, :], bundle.cog)
         cb = np.einsum("bij,jb->b", turned[:, 1:2, :], bundle.cob)
-        return float(np.sum(bundle.mass * self.g * (pose[1] + c) - bundle.lift * (pose[1] + cb)))
+        stretch = pose[:3] - bundle.rest
+        return float(np.sum(bundle.mass * self.g * (pose[1] + c) - bundle.lift * (pose[1] + cb))
+                     + 0.5 * np.sum(bundle.spring * stretch * stretch))
 
     def moved(self, pose: np.ndarray, du: np.ndarray, fraction: float) -> np.ndarray:
         return turn_bodies(pose, du, self.dim, fraction)

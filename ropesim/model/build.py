@@ -196,7 +196,7 @@ def _system_nodes(scene: S.Scene, lines) -> Nodes:
             held_v[:, on_point] = np.asarray(point.velocity)[:, None]
             drives.append((on_point, point))
     on_bodies = attachments(scene, ends)
-    rigid = [(body, on_bodies[body.id]) for body in scene.rigid_bodies if body.kind == "driven"]
+    rigid = [(body, on_bodies[body.id]) for body in scene.rigid_bodies if body.kind in RIGID_MOTION_KINDS]
     for body in scene.rigid_bodies:
         if body.kind != "free":
             held[[node for node, _ in on_bodies[body.id]]] = True
@@ -214,6 +214,9 @@ def point_position(scene: S.Scene, point: S.Point) -> tuple:
     arm = np.zeros(3)
     arm[:dim] = point.position
     return tuple((pose[:3] + rotation_matrix(pose[3:]) @ arm)[:dim])
+
+
+RIGID_MOTION_KINDS = ("driven", "coupled")          # a body that moves its points rigidly (model/motion.py)
 
 
 class EquilibriumError(ValueError):

@@ -159,3 +159,28 @@ def template_of(dispatcher):
 def template_name(qualname: str) -> str:
     """A compiled function's name without the switch values :func:`specialise` appends to a copy's."""
     return COPY_SUFFIX.sub("", qualname)
+
+
+class Direct:
+    """``dispatcher`` called without Numba's type dispatch: the first call goes through it (compiling if need
+    be) and finds the compiled copy for its arguments' types; every later call enters that copy directly.
+
+    Numba's dispatch types every argument at every call, and the bundles (namedtuples of arrays) cost tens of
+    microseconds to type, several times a small system's step: what a coupling step of one internal step must
+    not pay (:mod:`ropesim.coupling`). Only for calls whose arguments keep their types from call to call (the
+    same bundles, arrays of the same dtype, dimensions and layout, Python ints and floats where they were):
+    the copy checks nothing."""
+
+    def __init__(self, dispatcher):
+        self.dispatcher, self.entry = dispatcher, None
+
+    def __call__(self, *args):
+        if self.entry is not None:
+            return self.entry(*args)
+        from numba import typeof
+
+        out = self.dispatcher(*args)
+        compiled = self.dispatcher.overloads.get(tuple(typeof(a) for a in args))
+        if compiled is not None:
+            self.entry = compiled.entry_point
+        return out

@@ -104,9 +104,11 @@ def _body_motions(dim: int, bodies) -> Motion:
         turns = len(rows) - dim
         pose0[:dim, b] = body.position
         pose0[[r for r in rows[dim:]], b] = np.radians(body.orientation)
-        base[rows[:dim], b] = body.velocity
-        base[rows[dim:], b] = np.radians(body.angular_velocity)
-        ramp[b] = body.ramp_time
+        if body.velocity is not None:   # a coupled body: none, its motion comes at every coupling step
+            base[rows[:dim], b] = body.velocity
+        if body.angular_velocity is not None:
+            base[rows[dim:], b] = np.radians(body.angular_velocity)
+        ramp[b] = body.ramp_time or 0.0
         scale = np.array([1.0] * dim + [math.pi / 180.0] * turns)   # angles in degrees
         if body.amplitude is not None:
             amp[rows, b] = np.asarray(body.amplitude) * scale

@@ -54,9 +54,9 @@ def followed_nodes(model: Model, follow: bool) -> np.ndarray | None:
     if scene.is_system:
         from ..model.layout import point_ends
 
-        driven_bodies = {b.id for b in scene.rigid_bodies if b.kind == "driven"}
+        driven_bodies = {b.id for b in scene.rigid_bodies if b.kind in ("driven", "coupled")}
         ends = point_ends(scene, model.lines)
-        nodes = sorted(i for p in scene.points if p.kind == "driven" or (p.kind == "body" and p.body in driven_bodies)
+        nodes = sorted(i for p in scene.points if p.kind in ("driven", "coupled") or (p.kind == "body" and p.body in driven_bodies)
                        for i in ends[p.id])
         if not nodes:
             raise RenderError(f"--follow: scene '{scene.name}' has no driven point or body to follow")

@@ -460,6 +460,11 @@ class RigidBody:
                                     required=False)
     added_inertia: tuple | None = spec("angles", "added moment of inertia about each body axis", "kg m^2",
                                        default=None, required=False)
+    stiffness: tuple | None = spec("vector", "free body: a linear spring pulling its reference point back to where "
+                                             "it starts, along each world axis (a hydrostatic stiffness: rho g A_wp in "
+                                             "heave)", "N/m", default=None, required=False)
+    damping: tuple | None = spec("vector", "free body: linear damping on its reference point's velocity along each "
+                                           "world axis (radiation damping)", "N s/m", default=None, required=False)
     velocity: tuple | None = spec("vector", "driven: constant velocity of the reference point; free: its velocity "
                                             "at t = 0", "m/s", default=None, required=False)
     angular_velocity: tuple | None = spec("angles", "driven: constant rotation rate about x, y, z (world axes); free: "

@@ -172,7 +172,9 @@ def _resolve_point(scene: S.Scene, j: int, point: S.Point, base_dir: Path, fail)
     if kind != "driven":
         given = [k for k in (*MOTION_KEYS, "ramp_time") if getattr(point, k) is not None]
         if given:
-            instead = "drive its body instead" if kind == "body" else "set kind = 'driven' to move it so"
+            instead = ("drive its body instead" if kind == "body" else
+                       "the coupled program gives its motion at every step" if kind == "coupled" else
+                       "set kind = 'driven' to move it so")
             fail(f"{key}.{given[0]}", f"is a driven point's motion; this point is '{kind}' ({instead})")
         return replace(point, kind=kind)
     labels = ("dx", "dy", "dz")[: scene.dimension]
@@ -204,6 +206,13 @@ def _resolve_body(scene: S.Scene, j: int, body: S.RigidBody, base_dir: Path, fai
         if body.inertia is None:
             fail(f"{key}.inertia", "missing: a free body needs its moments of inertia about its centre of gravity "
                                    f"[kg m^2] ({'Ixx, Iyy, Izz' if dim == 3 else 'Izz'})")
+    if body.kind != "free":
+        for k in ("stiffness", "damping"):
+            if getattr(body, k) is not None:
+                fail(f"{key}.{k}", f"acts on a free body; this body is '{body.kind}' and does not move by its forces")
+    for k in ("stiffness", "damping"):
+        if getattr(body, k) is not None and min(getattr(body, k)) < 0:
+            fail(f"{key}.{k}", f"must be at least 0 along every axis, got {list(getattr(body, k))}")
     if body.kind == "free":   # its velocities at t = 0, at rest unless given
         body = replace(body, velocity=body.velocity if body.velocity is not None else zeros,
                        angular_velocity=body.angular_velocity if body.angular_velocity is not None else turns)

@@ -1,0 +1,499 @@
+"""Couple ropesim to another program: it moves the coupled points and bodies, ropesim returns their lines' forces.
+
+A scene's points and bodies of kind ``coupled`` are moved by the caller (a hydrodynamics code, a controller, a
+wave-energy model), as MoorDyn's coupled points and bodies are. At every coupling step the caller gives each
+coupled object's position and velocity at the step's start, time t; ropesim moves it on the straight line
+x(t + tau) = x + V tau for the whole step (MoorDyn's rule, ``Body::updateFairlead``), takes its own internal
+steps of the scene's integrator inside the step, and returns the forces and moments on the coupled objects at
+the step's end. A coupled body moves its points rigidly, as a driven body does (:mod:`ropesim.model.motion`):
+its pose is its reference point and its angles about x, then y, then z (R = Rz Ry Rx), and the caller gives the
+angles' rates with its velocity.
+
+Degrees of freedom, in the scene's frame and in the scene's order of ``[[bodies]]`` then ``[[points]]`` (MoorDyn
+too lists coupled bodies before coupled points): a coupled body has 6 in 3-D (x, y, z [m], then the angles
+about x, y, z [rad]) and 3 in 2-D (x, y, the angle about z); a coupled point has one per axis. The forces come
+in the same layout: a body's force [N] on its reference point and the moment [N m] about it (world axes), a
+point's force [N].
+
+The force on a coupled point is the net force on its line ends' nodes without their inertia, what MoorDyn
+reports for a coupled point (``Point::getFnet``): the lines' pull and the weight, buoyancy, drag and seabed push
+on the half segments the point carries. A body's is the sum of its points', and their moments. The caller's
+model adds its own mass, buoyancy and drag (a coupled body has none in ropesim).
+
+The internal step is the scene's ``integrator.dt``; the first coupling step shrinks it, as MoorDyn shrinks dtM,
+to dt / ceil(dt / integrator.dt) when dt is not a whole number of it, and every later coupling step must be a
+whole number of internal steps. Time starts at 0 at :meth:`Coupling.init`.
+
+With a ``folder`` the run is recorded as an ordinary run folder (frames every ``output.interval``, checkpoints
+by :meth:`Coupling.checkpoint`, finished by :meth:`Coupling.close`), which every command reads; a coupling
+stopped after a checkpoint continues bit for bit with :meth:`Coupling.resume`. Without one,
+:meth:`Coupling.state` and :meth:`Coupling.restore` hand its complete state over in memory.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from .integrate.grid import TimeGrid
+from .integrate.health import E0, OK
+from .model.build import Model, build
+from .model.jit import Direct
+
+BODY_ROWS = {3: (0, 1, 2, 3, 4, 5), 2: (0, 1, 5)}   # a body's degrees of freedom among a driven body's six rows
+STEP_TOLERANCE = 1e-9                              # relative: a coupling step is a whole number of internal steps
+UNBOUNDED_STEPS = 2 ** 62                          # a coupling has no t_end: its grid never reaches its last step
+
+
+class CouplingError(ValueError):
+    """A coupling call that cannot be honoured; ``str()`` is one line for the user."""
+
+
+@dataclass(frozen=True)
+class CoupledObject:
+    """One coupled point or body: its id, ``kind`` ("point" or "body"), its degrees of freedom and where they
+    sit in the coupling's arrays (``first``), its held rows (a point's line-end nodes) or its index among the
+    bodies that move their points rigidly (a body)."""
+
+    id: str
+    kind: str
+    dofs: int
+    first: int
+    rows: tuple = ()
+    body: int = -1
+
+    @property
+    def part(self) -> slice:
+        return slice(self.first, self.first + self.dofs)
+
+
+def coupled_objects(model: Model) -> tuple[CoupledObject, ...]:
+    """The scene's coupled bodies then coupled points, each with its degrees of freedom and held rows."""
+    from .model.build import RIGID_MOTION_KINDS
+    from .model.layout import point_ends
+
+    scene, dim = model.scene, model.dim
+    row = {int(node): j for j, node in enumerate(model.held_idx)}
+    out, first = [], 0
+    rigid = [b for b in scene.rigid_bodies if b.kind in RIGID_MOTION_KINDS]
+    for body in scene.rigid_bodies:
+        if body.kind == "coupled":
+            b = rigid.index(body)
+            rows = tuple(int(j) for j in np.flatnonzero(np.asarray(model.motion.rigid) == b))
+            out.append(CoupledObject(body.id, "body", len(BODY_ROWS[dim]), first, rows, b))
+            first += len(BODY_ROWS[dim])
+    ends = point_ends(scene, model.lines)
+    for point in scene.points:
+        if point.kind == "coupled":
+            out.append(CoupledObject(point.id, "point", dim, first, tuple(row[i] for i in ends[point.id])))
+            first += dim
+    return tuple(out)
+
+
+def objects_bundle(objects: tuple[CoupledObject, ...], dim: int):
+    """The coupled objects as the compiled ends of a step take them (:class:`ropesim.model.coupled.Objects`)."""
+    from .model.coupled import BODY, POINT, Objects
+
+    starts = np.cumsum([0] + [len(o.rows) for o in objects])
+    return Objects(np.array([POINT if o.kind == "point" else BODY for o in objects], dtype=np.int64),
+                   np.array([o.first for o in objects], dtype=np.int64),
+                   np.array([o.body for o in objects], dtype=np.int64), starts.astype(np.int64),
+                   np.array([j for o in objects for j in o.rows], dtype=np.int64),
+                   np.array(BODY_ROWS[dim], dtype=np.int64))
+
+
+class Coupling:
+    """A system advanced one coupling step at a time by another program (see the module doc).
+
+        coupling = ropesim.Coupling("spar.toml")
+        f = coupling.init()                    # the static solve with the coupled objects held; forces at t = 0
+        for k in range(steps):
+            f = coupling.step(k * dt, dt, x, v)   # the coupled objects' positions and velocities at t = k dt
+        coupling.close()
+
+    ``scene``: a :class:`~ropesim.Scene` or a scene file with at least one point or body of kind ``coupled``;
+    ``folder``: where to record the run as a run folder (None: nothing is written).
+    """
+
+    def __init__(self, scene, folder: str | Path | None = None):
+        from .scene.loader import load_scene
+
+        if isinstance(scene, (str, Path)):
+            scene = load_scene(scene)
+        if not scene.is_system:
+            raise CouplingError(f"{scene.name}: a coupling moves a system's coupled points and bodies; this scene "
+                                f"is one rope ([rope]): give it [[lines]] between [[points]]")
+        self.scene = scene
+        self.model = build(scene, solve=False)
+        self.objects = coupled_objects(self.model)
+        if not self.objects:
+            raise CouplingError(f"{scene.name}: no point or body has kind = 'coupled', so there is nothing for the "
+                                f"coupled program to move; give the points or bodies it moves kind = 'coupled'")
+        self.dofs = sum(o.dofs for o in self.objects)
+        self.folder = None if folder is None else Path(folder)
+        self.integrator = None
+        self.writer = None
+        self._rows = None
+        self._begin_step = self._end = self._no_frames = None
+        self._objects = objects_bundle(self.objects, self.model.dim)
+        self._acc = np.zeros((self.model.dim, self.model.nodes))
+        self.wall_time = 0.0
+
+    # -- what the caller asks ------------------------------------------------------------------------------
+
+    @property
+    def t(self) -> float:
+        """The coupling's time [s]: 0 at :meth:`init`, the end of the last coupling step since."""
+        return 0.0 if self.integrator is None else self.integrator.t
+
+    @property
+    def dt(self) -> float:
+        """The internal step [s]."""
+        return self.scene.integrator.dt if self.integrator is None else self.integrator.grid.dt
+
+    def positions(self) -> np.ndarray:
+        """The coupled objects' positions as the scene places them (the layout of :meth:`step`'s arrays)."""
+        out = np.zeros(self.dofs)
+        points = {p.id: p for p in self.scene.points}
+        bodies = {b.id: b for b in self.scene.rigid_bodies}
+        dim = self.model.dim
+        for o in self.objects:
+            if o.kind == "point":
+                out[o.part] = points[o.id].position
+            else:
+                body = bodies[o.id]
+                out[o.first:o.first + dim] = body.position
+                out[o.first + dim:o.first + o.dofs] = np.radians(body.orientation)
+        return out
+
+    def init(self, positions=None, velocities=None, *, statics: bool = True) -> np.ndarray:
+        """Start at t = 0 with the coupled objects at ``positions`` moving at ``velocities`` (default: where the
+        scene puts them, at rest), after the static solve with them held there (``statics``; the scene's own
+        start shape otherwise). Returns the forces on the coupled objects at t = 0."""
+        if self.integrator is not None:
+            raise CouplingError(f"{self.scene.name}: init() was called already; make a new Coupling to start again")
+        x = self._checked(self.positions() if positions is None else positions, "positions")
+        v = self._checked(np.zeros(self.dofs) if velocities is None else velocities, "velocities")
+        from .model.motion import Held
+
+        model = self.model
+        motion = model.motion._replace(accel=model.motion.accel.copy())
+        self._begin(0.0, x, v, Held(model.held_idx, model.held_x0, model.held_v, motion), model.x0, model.v0)
+        if statics:
+            self._solve_statics()
+        self._start(self.scene.integrator.dt)
+        return self._end_forces()
+
+    def step(self, t: float, dt: float, positions, velocities) -> np.ndarray:
+        """One coupling step from time ``t`` (the coupling's own time, :attr:`t`) to t + ``dt``, with the coupled
+        objects at ``positions`` moving at ``velocities`` at t (arrays of :attr:`dofs` numbers); returns the forces
+        and moments on them at t + dt (:attr:`dofs` numbers, the same layout)."""
+        if self.integrator is None:
+            raise CouplingError(f"{self.scene.name}: step() before init(); call init() first (it solves the "
+                                f"static shape and starts the clock at t = 0)")
+        if not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt) and dt > 0):
+            raise CouplingError(f"{self.scene.name}: step: dt = {dt!r}; give a positive, finite coupling step [s]")
+        if not (isinstance(t, (int, float, np.floating)) and math.isfinite(t)) or abs(t - self.t) > 1e-9 * max(
+                abs(self.t), dt):
+            raise CouplingError(f"{self.scene.name}: step: t = {t!r} s, but the coupling stands at t = {self.t!r} s; "
+                                f"each step starts where the last one ended (the first at t = 0)")
+        x = self._checked(positions, "positions")
+        v = self._checked(velocities, "velocities")
+        n = self._internal_steps(float(dt))
+        return self._advance(n, x, v)
+
+    def mass(self) -> np.ndarray:
+        """The mass matrix (dofs, dofs) [kg, kg m, kg m^2] of what the coupled objects carry now: their line ends'
+        lumped masses m_i and added masses a_n (I - q q^T) + a_t q q^T (q the node's tangent), a body's about its
+        reference point in world axes. The forces :meth:`step` returns leave this inertia out (MoorDyn's report);
+        a caller's model adds it to its own mass, as a free body inside ropesim carries its attachments'."""
+        model, i = self.model, self.integrator
+        if i is None:
+            raise CouplingError(f"{self.scene.name}: mass() before init()")
+        dim, x = model.dim, i.x
+        added = np.asarray(model.params.added_mass)
+        around = np.asarray(model.params.neighbours)
+        out = np.zeros((self.dofs, self.dofs))
+        for o in self.objects:
+            block = np.zeros((6, 6))
+            if o.kind == "body":
+                m = model.motion.bodies
+                ref = m.accel[:dim, o.body] + m.base[:dim, o.body] * i.t
+            for j in o.rows:
+                node = model.held_idx[j]
+                mi = model.mass[node] * np.eye(3)
+                if added.size:
+                    q = np.zeros(3)
+                    q[:dim] = x[:, around[1, node]] - x[:, around[0, node]]
+                    norm = np.linalg.norm(q)
+                    q = q / norm if norm > 0 else q
+                    a_n, a_t = added[0, node], added[1, node]
+                    mi = mi + a_n * (np.eye(3) - np.outer(q, q)) + a_t * np.outer(q, q)
+                arm = np.zeros(3)
+                if o.kind == "body":
+                    arm[:dim] = x[:, node] - ref
+                cross = np.array([[0, -arm[2], arm[1]], [arm[2], 0, -arm[0]], [-arm[1], arm[0], 0]])
+                block[:3, :3] += mi
+                block[:3, 3:] -= mi @ cross
+                block[3:, :3] += cross @ mi
+                block[3:, 3:] -= cross @ mi @ cross
+            keep = list(range(dim)) + ([3, 4, 5] if dim == 3 else [5]) if o.kind == "body" else list(range(dim))
+            out[o.part, o.part] = block[np.ix_(keep, keep)]
+        return out
+
+    # -- state ---------------------------------------------------------------------------------------------
+
+    COUPLING_STATE = ("coupling_held_x0", "coupling_held_v", "coupling_base", "coupling_body_pose0",
+                      "coupling_body_base", "coupling_dt")
+
+    def state(self) -> dict[str, np.ndarray]:
+        """The complete state (copies): the integrator's and the coupled objects' motion of the last step."""
+        if self.integrator is None:
+            raise CouplingError(f"{self.scene.name}: state() before init(): there is no state yet")
+        m = self.model.motion
+        out = self.integrator.state()
+        out.update(coupling_held_x0=self.model.held_x0.copy(), coupling_held_v=self.integrator.held.v.copy(),
+                   coupling_base=m.base.copy(), coupling_dt=np.array(self.integrator.grid.dt))
+        if m.bodies is not None:
+            out.update(coupling_body_pose0=m.bodies.accel.copy(), coupling_body_base=m.bodies.base.copy())
+        return out
+
+    def restore(self, state: dict[str, np.ndarray]) -> None:
+        """Continue from ``state`` (from :meth:`state` of a coupling of the same scene): the next step gives, bit
+        for bit, what the coupling that saved it would have given."""
+        if self.integrator is None or self.integrator.grid.dt != float(state["coupling_dt"]):
+            self._start(float(state["coupling_dt"]), record_first=False)
+        m = self.model.motion
+        np.copyto(self.model.held_x0, state["coupling_held_x0"])
+        np.copyto(self.integrator.held.v, state["coupling_held_v"])
+        np.copyto(m.base, state["coupling_base"])
+        if m.bodies is not None:
+            np.copyto(m.bodies.accel, state["coupling_body_pose0"])
+            np.copyto(m.bodies.base, state["coupling_body_base"])
+        self.integrator.restore({k: v for k, v in state.items() if k not in self.COUPLING_STATE})
+
+    def checkpoint(self) -> None:
+        """Commit the recorded frames and the complete state to the run folder: :meth:`resume` continues from
+        here."""
+        if self.writer is None:
+            raise CouplingError(f"{self.scene.name}: checkpoint() needs a run folder; give Coupling(scene, folder)")
+        self.writer.checkpoint(self.state(), self.integrator.step, self.t, extra={"wall_time_s": self.wall_time})
+
+    @classmethod
+    def resume(cls, folder: str | Path) -> "Coupling":
+        """The coupling recorded in ``folder``, at its last checkpoint (frames after it are dropped), recording
+        on into the same folder."""
+        from .io.runfolder import SCENE, RunFolderError, RunWriter, scene_hash
+        from .run import frame_specs
+        from .scene.loader import SceneError, scene_from_toml
+
+        folder = Path(folder)
+        writer = RunWriter.reopen(folder)
+        try:
+            text = (folder / SCENE).read_text(encoding="utf-8")
+            if scene_hash(text) != writer.manifest.get("scene_sha256"):
+                raise RunFolderError(f"{folder / SCENE}: changed since the coupling began; it cannot continue")
+            try:
+                scene = scene_from_toml(text, source=str(folder / SCENE))
+            except SceneError as exc:
+                raise RunFolderError(f"{folder / SCENE}: cannot be read ({exc})") from None
+            self = cls(scene)
+            state, _ = writer.load_checkpoint(frame_specs(self.model))
+            self.folder, self.writer = folder, writer
+            self.restore(state)
+            self.wall_time = float((writer.manifest.get("checkpoint") or {}).get("wall_time_s", 0.0))
+            return self
+        except BaseException:
+            writer.close()
+            raise
+
+    def close(self) -> None:
+        """Finish the recorded run folder (its last state saved as a frame, trajectory.npz, ledger.npz and the
+        summary written, scene.toml's t_end and dt those the coupling reached): every command reads it."""
+        if self.writer is None:
+            return
+        try:
+            self._finish()
+        finally:
+            self.writer.close()
+            self.writer = None
+
+    def __enter__(self) -> "Coupling":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # -- inside --------------------------------------------------------------------------------------------
+
+    def _checked(self, values, what: str) -> np.ndarray:
+        try:
+            a = np.array(values, dtype=np.float64)   # a fresh C-ordered copy: the compiled calls take no other
+        except (TypeError, ValueError):
+            raise CouplingError(f"{self.scene.name}: {what}: not an array of numbers ({type(values).__name__}); "
+                                f"give {self.dofs} numbers ({self.layout()})") from None
+        if a.shape != (self.dofs,):
+            raise CouplingError(f"{self.scene.name}: {what}: {a.size} numbers of shape {a.shape}; the coupled "
+                                f"objects have {self.dofs} degrees of freedom ({self.layout()})")
+        if not np.isfinite(a).all():
+            k = int(np.flatnonzero(~np.isfinite(a))[0])
+            raise CouplingError(f"{self.scene.name}: {what}[{k}] = {float(a[k])!r} ({self._dof_name(k)}); every value "
+                                f"must be a finite number")
+        return a
+
+    def layout(self) -> str:
+        """The arrays' layout in words: 'spar: x y z rx ry rz, fairlead1: x y z'."""
+        return ", ".join(f"{o.id}: {' '.join(self._names(o))}" for o in self.objects)
+
+    def _names(self, o: CoupledObject) -> tuple[str, ...]:
+        axes = ("x", "y", "z")[: self.model.dim]
+        if o.kind == "point":
+            return axes
+        return axes + (("rx", "ry", "rz") if self.model.dim == 3 else ("rz",))
+
+    def _dof_name(self, k: int) -> str:
+        for o in self.objects:
+            if o.first <= k < o.first + o.dofs:
+                return f"{o.id} {self._names(o)[k - o.first]}"
+        return "?"
+
+    def _internal_steps(self, dt: float) -> int:
+        h = self.integrator.grid.dt
+        n = round(dt / h)
+        if n >= 1 and abs(n * h - dt) <= STEP_TOLERANCE * dt:
+            return n
+        if self.integrator.step == 0:      # MoorDyn's rule: the internal step shrinks to fit the coupling step
+            n = math.ceil(dt / h * (1 - 1e-12))
+            self._start(dt / n, record_first=False)
+            return n
+        raise CouplingError(f"{self.scene.name}: step: dt = {dt!r} s is not a whole number of internal steps of "
+                            f"{h!r} s (set by the first coupling step); give a multiple of it")
+
+    def _begin(self, t0: float, x: np.ndarray, v: np.ndarray, held, state_x: np.ndarray,
+               state_v: np.ndarray) -> None:
+        """Move every coupled object on x + v (t - t0) from time t0 (the loops' own time) and place the held
+        nodes of ``state_x``, ``state_v`` there at t0 (:func:`ropesim.model.coupled.begin_step`)."""
+        if self._begin_step is None:
+            from .model.coupled import begin_step
+
+            self._begin_step = Direct(self.model.kernel(begin_step))
+        self._begin_step(float(t0), x, v, self._objects, held, state_x, state_v)
+
+    def _solve_statics(self) -> None:
+        from .model.build import EquilibriumError
+        from .model.statics import solve_equilibrium
+
+        result = solve_equilibrium(self.model)
+        if not result.converged:
+            raise EquilibriumError(f"{self.scene.name}: the static solve with the coupled objects held did not "
+                                   f"converge (largest residual force {result.residual:.3g} N after "
+                                   f"{result.iterations} iterations); init(statics=False) starts from the scene's "
+                                   f"shape")
+        self.model.x0[:] = result.x
+
+    def _start(self, h: float, record_first: bool = True) -> None:
+        """The integrator from the model's state at t = 0 with internal step h; the first frame recorded."""
+        from .integrate.methods import make_integrator
+        from .run import frame_specs
+
+        scene = self.scene
+        if self.integrator is not None:   # the first coupling step chose another internal step: same state at t = 0
+            self.model.x0[:] = self.integrator.x
+            self.model.v0[:] = self.integrator.v
+            self.model.held_v[:] = self.integrator.held.v
+        save_every = max(1, round(scene.output.interval / h))
+        grid = TimeGrid(dt=h, steps=UNBOUNDED_STEPS, save_every=save_every, requested_dt=scene.integrator.dt)
+        self.integrator = make_integrator(self.model, grid)
+        self._no_frames = None
+        self.integrator.warm_up()
+        self.integrator.loop = Direct(self.integrator.loop)   # its arguments keep their types: no dispatch
+        if self.folder is not None and self.writer is None:
+            from .io.runfolder import RunWriter
+            from .run import _manifest_info
+            from .scene.schema import scene_to_toml
+
+            self.writer = RunWriter.create(self.folder, scene_to_toml(scene), frame_specs(self.model),
+                                           _manifest_info(scene, grid))
+        if self.writer is not None:
+            from .io.trajectory import FrameStore
+            from .model.tension import frame_arrays
+
+            model = self.model
+            self._rows = FrameStore(0, model.nodes, model.dim,
+                                    derive=lambda t, x, v, body: frame_arrays(model, t, x, v, body)).rows
+            if record_first and self.writer.count == 0:
+                self._record_now()
+
+    def _record_now(self) -> None:
+        from .integrate.health import LEDGER_COLUMNS
+
+        i = self.integrator
+        ledger = np.zeros((1, len(LEDGER_COLUMNS))) if i.step == 0 else i.ledger[None, :len(LEDGER_COLUMNS)].copy()
+        self.writer.append(self._rows(np.array([i.t]), i.x[None].copy(), i.v[None].copy(), ledger,
+                                      i.body_rows()[None]))
+
+    def _advance(self, n: int, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+        i = self.integrator
+        tick = time.perf_counter()
+        self._begin(i.t, x, v, i.held, i.x, i.v)
+        if i.frames_in(n):
+            frames = i.new_frames(n)
+        else:                               # most coupling steps save no frame: the same empty buffers
+            if self._no_frames is None:
+                self._no_frames = i.new_frames(0)
+            frames = self._no_frames
+        done, written, status, node = i._run(n, frames)     # Integrator.advance, without its bundling
+        i.step += done
+        if self.writer is not None and written:
+            self.writer.append(self._rows(frames.t[:written], frames.x[:written], frames.v[:written],
+                                          frames.ledger[:written], frames.body[:written]))
+        if status != OK:
+            from .run import _blow_up_message
+
+            _, message = _blow_up_message(self.model, i, status, node)
+            raise CouplingError(f"{self.scene.name}: {message}")
+        forces = self._end_forces()
+        self.wall_time += time.perf_counter() - tick
+        return forces
+
+    def _end_forces(self) -> np.ndarray:
+        """The forces and moments on the coupled objects now (see the module doc;
+        :func:`ropesim.model.coupled.end_forces`)."""
+        model, i = self.model, self.integrator
+        if self._end is None:
+            from .model.coupled import end_forces
+
+            self._end = Direct(model.kernel(end_forces))
+        out = np.zeros(self.dofs)
+        self._end(i.x, i.v, self._acc, model.params, float(i.t), model.mass, self._objects, i.held, out)
+        return out
+
+    def _finish(self) -> None:
+        from .analysis.ledger import ledger_arrays
+        from .analysis.summary import summarize
+        from .io.atomic import write_text_atomic
+        from .io.runfolder import COMPLETED, LEDGER, SCENE, TRAJECTORY, scene_hash
+        from .run import COMPLETED as DONE, RunOutcome, _manifest_info
+        from .scene.schema import scene_to_toml
+
+        i, writer = self.integrator, self.writer
+        if i.step % i.grid.save_every:     # an ordinary run's frames end with its last step
+            self._record_now()
+        scene = replace(self.scene, integrator=replace(self.scene.integrator, t_end=i.t, dt=i.grid.dt))
+        text = scene_to_toml(scene)
+        write_text_atomic(writer.folder / SCENE, text)
+        grid = TimeGrid(dt=i.grid.dt, steps=i.step, save_every=i.grid.save_every, requested_dt=i.grid.dt)
+        writer.manifest.update(_manifest_info(scene, grid), scene_sha256=scene_hash(text))
+        arrays = writer.arrays()
+        outcome = RunOutcome(status=DONE, steps=i.step, t_reached=i.t, wall_time=self.wall_time, compile_time=0.0,
+                             grid=grid, ledger=arrays["ledger"], energy0=float(i.ledger[E0]),
+                             force_evaluations=i.force_evaluations, integrator=i)
+        summary = summarize(self.model, outcome, arrays["t"], arrays["x"], arrays["v"], arrays["tension"], arrays)
+        summary["coupled"] = [o.id for o in self.objects]
+        files = {TRAJECTORY: {k: a for k, a in arrays.items() if k != "ledger"},
+                 LEDGER: ledger_arrays(arrays["t"], arrays["ledger"], outcome.energy0)}
+        writer.finish(COMPLETED, self.state(), files, summary)

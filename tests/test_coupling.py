@@ -1,0 +1,211 @@
+"""ropesim.Coupling: another program moves the coupled points and bodies, ropesim returns their lines' forces.
+
+OC3-Hywind's three chains (tests/data/systems/oc3_hywind.toml) with the spar coupled instead of driven. Physics:
+driven through the coupling with the driven twin's own prescribed surge, sampled at the coupling steps, the
+forces on the spar converge to the driven run's as the coupling step shrinks, at first order (the fairleads
+move at the step's initial velocity for the whole step, MoorDyn's rule, so their velocity at the step's end is
+off by the surge acceleration times the step, and the chains' axial damping feels it). A restart from a
+checkpoint continues bit for bit; bad calls are refused in one line.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import ropesim
+from ropesim.coupling import CouplingError
+
+SCENE = Path(__file__).parent / "data" / "systems" / "oc3_hywind.toml"
+DRIVEN = SCENE.read_text()
+COUPLED = re.sub(r'kind = "driven"\n(position = [^\n]*\n)amplitude = [^\n]*\nperiod = [^\n]*\nramp_time = [^\n]*\n',
+                 r'kind = "coupled"\n\1', DRIVEN)
+FAST = ["integrator.method=verlet", "integrator.dt=0.001", "initial.shape=lines", "output.interval=0.1"]
+
+
+def coupled_scene(more=()):
+    return ropesim.scene_from_toml(COUPLED, source="oc3_coupled.toml", overrides=[*FAST, *more])
+
+
+def test_the_coupled_spar_is_a_coupled_body_with_six_degrees_of_freedom():
+    coupling = ropesim.Coupling(coupled_scene())
+    assert coupling.dofs == 6
+    assert coupling.layout() == "spar: x y z rx ry rz"
+    assert np.array_equal(coupling.positions(), np.zeros(6))
+
+
+@pytest.fixture(scope="module")
+def driven_run():
+    scene = ropesim.scene_from_toml(DRIVEN, source="oc3.toml", overrides=[*FAST, "integrator.t_end=16",
+                                                                          "output.interval=0.05"])
+    return ropesim.simulate(scene)
+
+
+def spar_force(traj) -> np.ndarray:
+    """The net force on the spar's three fairleads without their inertia (F, 3), from the run's held_force."""
+    return sum(traj.point(f"fairlead{k}").held_force for k in (1, 2, 3))
+
+
+def coupled_forces(dt: float, t_end: float) -> tuple[np.ndarray, np.ndarray]:
+    """(times, forces on the spar (K, 6)) of the coupled twin driven with the driven scene's surge."""
+    from ropesim.model.bodies import driven_pose
+    from ropesim.model.build import build
+
+    driven = build(ropesim.scene_from_toml(DRIVEN, source="oc3.toml", overrides=FAST), solve=False)
+    body = driven.scene.rigid_bodies[0]
+    coupling = ropesim.Coupling(coupled_scene())
+    coupling.init(statics=False)
+    steps = round(t_end / dt)
+    times = np.arange(steps + 1) * dt
+    position, _, velocity, _ = driven_pose(driven, body, times)
+    out = np.zeros((steps, 6))
+    for k in range(steps):
+        x = np.concatenate([position[k], np.zeros(3)])
+        v = np.concatenate([velocity[k], np.zeros(3)])
+        out[k] = coupling.step(times[k], dt, x, v)
+    return times[1:], out
+
+
+def test_forces_converge_to_the_driven_runs_at_first_order_in_the_coupling_step(driven_run):
+    reference = spar_force(driven_run)
+    errors = []
+    for dt in (0.2, 0.1, 0.05):
+        times, forces = coupled_forces(dt, 16.0)
+        frames = np.round(times / 0.05).astype(int)
+        errors.append(np.max(np.abs(forces[:, :3] - reference[frames])))
+    order = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all((order > 0.8) & (order < 1.3)), (errors, order)
+    # the leading error: three chains' damping BA / l on the velocity lag a dt, a the surge's acceleration
+    # (5 m at 60 s: 0.055 m/s^2, more while the ramp runs)
+    lag = 3 * 6.2358e6 / (902.2 / 20) * 5 * (2 * np.pi / 60) ** 2 * 0.05
+    assert errors[-1] < 4 * lag, (errors, lag)
+
+
+def test_a_coupled_spar_held_still_pulls_as_the_run_that_holds_it():
+    scene = coupled_scene(["integrator.t_end=2"])
+    run = ropesim.simulate(scene)
+    coupling = ropesim.Coupling(scene)
+    first = coupling.init(statics=False)
+    assert np.allclose(first[:3], spar_force(run)[0], rtol=1e-12, atol=1e-6)
+    for k in range(10):
+        forces = coupling.step(0.2 * k, 0.2, np.zeros(6), np.zeros(6))
+    assert np.allclose(forces[:3], spar_force(run)[-1], rtol=1e-9, atol=1e-3)
+
+
+def test_a_restart_from_a_checkpoint_continues_bit_for_bit(tmp_path):
+    scene = coupled_scene()
+    rng = np.random.default_rng(7)
+    motion = [(rng.normal(size=6) * [1, 0.2, 1, 0.01, 0.01, 0.01], rng.normal(size=6) * 0.1) for _ in range(20)]
+    coupling = ropesim.Coupling(scene, tmp_path / "run")
+    coupling.init(statics=False)
+    for k in range(10):
+        coupling.step(coupling.t, 0.05, *motion[k])
+    coupling.checkpoint()
+    straight = [coupling.step(coupling.t, 0.05, *motion[k]) for k in range(10, 20)]
+    straight_state = coupling.state()
+    coupling.writer.close()          # the process dies here: nothing after the checkpoint was committed
+    coupling.writer = None
+
+    again = ropesim.Coupling.resume(tmp_path / "run")
+    resumed = [again.step(again.t, 0.05, *motion[k]) for k in range(10, 20)]
+    assert all(np.array_equal(a, b) for a, b in zip(straight, resumed))
+    for name, value in straight_state.items():
+        assert np.array_equal(value, again.state()[name]), name
+    again.close()
+
+    traj = ropesim.Trajectory.open(tmp_path / "run")
+    assert traj.t[-1] == pytest.approx(1.0, abs=1e-12) and len(traj.t) == 11
+    assert traj.summary["status"] == "completed" and traj.summary["coupled"] == ["spar"]
+    assert np.allclose(spar_force(traj)[-1], resumed[-1][:3], rtol=1e-12, atol=1e-6)
+
+
+def test_the_first_coupling_step_shrinks_the_internal_step_to_fit_as_moordyn_does():
+    coupling = ropesim.Coupling(coupled_scene())
+    coupling.init(statics=False)
+    coupling.step(0.0, 0.0025, np.zeros(6), np.zeros(6))      # 0.0025 / 0.001: three steps of 0.000833 s
+    assert coupling.dt == pytest.approx(0.0025 / 3, rel=1e-15)
+    coupling.step(coupling.t, 0.0025 / 3 * 2, np.zeros(6), np.zeros(6))
+    with pytest.raises(CouplingError, match="not a whole number of internal steps"):
+        coupling.step(coupling.t, 0.001, np.zeros(6), np.zeros(6))
+
+
+@pytest.mark.parametrize("positions, velocities, t, dt, words", [
+    (np.zeros(5), np.zeros(6), 0.0, 0.1, "5 numbers of shape (5,); the coupled objects have 6 degrees of freedom"),
+    (np.zeros((2, 3)), np.zeros(6), 0.0, 0.1, "6 numbers of shape (2, 3)"),
+    ([0, 0, np.nan, 0, 0, 0], np.zeros(6), 0.0, 0.1, "positions[2] = nan (spar z)"),
+    (np.zeros(6), [0, 0, 0, 0, np.inf, 0], 0.0, 0.1, "velocities[4] = inf (spar ry)"),
+    (np.zeros(6), np.zeros(6), 1.0, 0.1, "t = 1.0 s, but the coupling stands at t = 0.0 s"),
+    (np.zeros(6), np.zeros(6), 0.0, -0.1, "dt = -0.1"),
+    (np.zeros(6), np.zeros(6), 0.0, float("nan"), "dt = nan"),
+    ("spar", np.zeros(6), 0.0, 0.1, "positions: not an array of numbers"),
+])
+def test_a_bad_coupling_call_is_refused_in_one_line(positions, velocities, t, dt, words):
+    coupling = ropesim.Coupling(coupled_scene())
+    with pytest.raises(CouplingError, match="init"):
+        coupling.step(0.0, 0.1, np.zeros(6), np.zeros(6))
+    coupling.init(statics=False)
+    with pytest.raises(CouplingError) as refused:
+        coupling.step(t, dt, positions, velocities)
+    message = str(refused.value)
+    assert words in message and "\n" not in message
+
+
+def test_a_scene_without_coupled_objects_is_refused():
+    scene = ropesim.scene_from_toml(DRIVEN, source="oc3.toml", overrides=FAST)
+    with pytest.raises(CouplingError, match="no point or body has kind = 'coupled'"):
+        ropesim.Coupling(scene)
+
+
+def test_held_force_is_minus_the_support_on_a_fixed_anchor(driven_run):
+    anchor = driven_run.point("anchor1")
+    row = np.flatnonzero([np.allclose(s, -anchor.held_force) for s in np.swapaxes(driven_run.support, 0, 1)])
+    assert row.size == 1
+    fairlead = driven_run.point("fairlead1")
+    assert fairlead.held_force is not None and np.all(np.isfinite(fairlead.held_force))
+
+
+PLANAR = """
+name = "planar_chain"
+dimension = 2
+[[points]]
+id = "anchor"
+position = [0.0, -20.0]
+[[points]]
+id = "top"
+kind = "coupled"
+position = [15.0, 0.0]
+[[lines]]
+id = "chain"
+start = "anchor"
+end = "top"
+length = 30.0
+segments = 12
+mass_per_length = 2.0
+EA = 1.0e5
+axial_damping = 200.0
+[gravity]
+g = 9.81
+[integrator]
+method = "verlet"
+dt = 0.001
+t_end = 1.0
+[output]
+interval = 0.1
+"""
+
+
+def test_a_planar_coupled_point_held_still_pulls_as_the_run_that_holds_it():
+    scene = ropesim.scene_from_toml(PLANAR, source="planar.toml")
+    run = ropesim.simulate(scene)
+    coupling = ropesim.Coupling(scene)
+    assert coupling.layout() == "top: x y"
+    coupling.init(statics=False)
+    for k in range(10):
+        forces = coupling.step(0.1 * k, 0.1, [15.0, 0.0], [0.0, 0.0])
+    held = run.point("top").held_force[-1]
+    assert np.allclose(forces, held, rtol=1e-9, atol=1e-9)
+    assert np.allclose(run.x[-1], coupling.integrator.x.T, rtol=0, atol=1e-12)
+    assert held[1] < 0 and held[0] < 0        # the chain hangs down towards its anchor, below and to the left
