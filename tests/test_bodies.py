@@ -160,6 +160,21 @@ interval = 2.0e-4
     return scene, math.sqrt(w2[mode])
 
 
+def test_the_summarys_final_energy_is_the_bodys_at_the_last_frame():
+    """summary.json's final energy takes the free body's state at the run's last frame (it took its initial pose and
+    twist): a quarter period after starting at rest at the swing's end, its kinetic energy is 1/2 m v^2 + 1/2 I w^2
+    of the last frame's velocity and angular velocity, and its potential energy m g y of the last frame's place."""
+    text, omega = body_on_a_string(0)
+    quarter = 0.5 * math.pi / omega
+    text = text.replace("t_end = 12.0", f"t_end = {quarter!r}").replace("interval = 2.0e-4", "interval = 2.0e-2")
+    traj = ropesim.simulate(scene_from_toml(text))
+    final = traj.summary["final_energy_J"]
+    v, w = traj.body_v[-1, 0], traj.body_w[-1, 0]
+    kinetic = 0.5 * 100.0 * float(v @ v) + 0.5 * 10.0 * float(w[2] ** 2)
+    assert kinetic > 1e-3 and final["body kinetic"] == pytest.approx(kinetic, rel=1e-12)
+    assert final["body gravity"] == pytest.approx(100.0 * 9.81 * float(traj.body_x[-1, 0, 1]), rel=1e-12)
+
+
 @pytest.mark.parametrize("mode", [0, 1])
 def test_a_body_on_a_string_swings_in_both_small_angle_modes_of_the_closed_form(mode):
     """Started in one mode, the string swings at that mode's frequency: within 0.2 % (the string's 0.1 kg, which

@@ -8,6 +8,7 @@ from .. import __version__
 from ..model.build import Model
 from ..model.forces.springs import segment_strains
 from ..model.tension import line_segments
+from ..model.bodies import free_body_state
 from ..model.energy import energy_terms
 from .ledger import ledger_series, ledger_summary
 from .stability import predicted_dt
@@ -75,7 +76,7 @@ def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray
     finite = bool(np.all(np.isfinite(x[-1])) and np.all(np.isfinite(v[-1])))
     if finite:
         with np.errstate(over="ignore", invalid="ignore"):  # a run stopped by a blow-up may end huge
-            summary.update(_physics_figures(model, t, x, v))
+            summary.update(_physics_figures(model, t, x, v, bodies))
             summary["energy_ledger"] = ledger_summary(ledger_series(model, x, v, outcome.ledger, outcome.energy0,
                                                                     bodies), outcome.energy0)
             if tension is not None and len(tension):
@@ -93,10 +94,16 @@ def _finite_or_none(value: float) -> float | None:
     return float(value) if np.isfinite(value) else None
 
 
-def _physics_figures(model: Model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> dict:
-    """Energy, largest stretch, and the figures of the parts the scene declares (towed rope, shooter loop)."""
+def _physics_figures(model: Model, t: np.ndarray, x: np.ndarray, v: np.ndarray, bodies: dict | None = None) -> dict:
+    """Energy at the last frame (the free bodies' too, from ``bodies``' per-frame arrays), largest stretch, and the
+    figures of the parts the scene declares (towed rope, shooter loop)."""
     scene = model.scene
-    energy = energy_terms(model, x[-1], v[-1])
+    pose = twist = None
+    if bodies is not None:
+        last = slice(len(t) - 1, len(t))
+        pose, twist = free_body_state(model, bodies, last)
+        pose, twist = (None, None) if pose is None else (pose[0], twist[0])
+    energy = energy_terms(model, x[-1], v[-1], pose, twist)
     stretch, at = largest_stretch(model, x)
     out: dict = {
         "final_energy_J": {k: float(val) for k, val in energy.items()},
