@@ -110,9 +110,11 @@ class Coupling:
     """A system advanced one coupling step at a time by another program (see the module doc).
 
         coupling = ropesim.Coupling("spar.toml")
-        f = coupling.init()                    # the static solve with the coupled objects held; forces at t = 0
+        # the static solve with the coupled objects held; their forces at t = 0:
+        f = coupling.init()
         for k in range(steps):
-            f = coupling.step(k * dt, dt, x, v)   # the coupled objects' positions and velocities at t = k dt
+            # x, v: the coupled objects' positions and velocities at t = k dt
+            f = coupling.step(k * dt, dt, x, v)
         coupling.close()
 
     ``scene``: a :class:`~ropesim.Scene` or a scene file with at least one point or body of kind ``coupled``;

@@ -539,7 +539,10 @@ def test_resolved_scene_shows_every_key_of_its_parts(path):
         for part, table in zip(parts, tables):
             expected = {f.name for f in fields(part) if getattr(part, f.name) is not None}
             assert set(table) == expected, key
-    assert {"nodes", "segment_length", "stiffness", "mass", "closed", "compression"} <= set(resolved["rope"])
+    if scene.is_system:   # each line's length and segments, and its type's material, written out
+        assert all({"id", "start", "end", "length", "segments"} <= set(line) for line in resolved["lines"])
+    else:
+        assert {"nodes", "segment_length", "stiffness", "mass", "closed", "compression"} <= set(resolved["rope"])
 
 
 def test_round_trip_of_the_shapes_not_in_scenarios():
@@ -666,7 +669,7 @@ def _accepted_or_one_line(text: str, sets=()):
             assert isinstance(scene.initial, S.EquilibriumStart)   # off): one named line too, exit 1 in the CLI
             assert "\n" not in str(exc) and "did not converge" in str(exc)
             return None
-        assert model.x0.shape == (scene.dimension, scene.rope.nodes)
+        assert model.x0.shape == (scene.dimension, model.nodes)
         grid = TimeGrid.of(scene)
         time_step_verdict(model, scene.integrator.method, scene.integrator.dt)
         make_integrator(model, grid, scene.integrator.method)
