@@ -51,7 +51,7 @@ def contenders(n: int, steps: int) -> dict:
 
         def run(st=st, plain=plain, m=m, check_every=check_every):
             st.loop(st.bundle, st.kicks, plain, st.general, st.held, m.mass, m.params, st.limits,
-                    Schedule(st.step, steps, NEVER, h, NEVER, check_every), st.new_frames(0))
+                    Schedule(st.step, steps, NEVER, h, NEVER, check_every), st.new_frames(0), st.bodies)
             st.step += steps
 
         run()   # compile this flag combination
