@@ -77,3 +77,15 @@ def test_a_spring_on_a_body_that_is_not_free_is_refused():
     with pytest.raises(ropesim.SceneError, match="bodies.0.stiffness: acts on a free body"):
         ropesim.scene_from_toml(text.replace("inertia = [100.0, 100.0, 100.0]\n", "").replace(
             "velocity = [0.0, 1.0, 0.0]\n", ""), source="s.toml")
+
+
+def test_the_static_solve_balances_a_free_bodys_weight_on_its_spring():
+    """With gravity and an equilibrium start, the spring holds the body m g / k below where it rests (its slack,
+    nearly massless line adds 1e-4 N to 9810 N): the static solve counts the spring's force, its energy in the
+    merit function and its stiffness in the Newton block."""
+    from ropesim.model.build import build
+
+    at_rest = SCENE.replace("velocity = [0.0, 1.0, 0.0]\n", "")
+    text = at_rest + '\n[gravity]\ng = 9.81\n[initial]\nshape = "equilibrium"\n'
+    model = build(ropesim.scene_from_toml(text, source="spring_body.toml"))
+    assert model.body_pose0[1, 0] == pytest.approx(-1000.0 * 9.81 / 4000.0, rel=1e-6)
