@@ -24,7 +24,7 @@ import re
 from pathlib import Path
 
 from .atomic import TEMPORARY_NAME
-from .runfolder import LOCK, RUN_MARKERS, STATE
+from .layout import LOCK, RUN_MARKERS, STATE
 
 SOFTWARE = "ropesim"    # the tag ropesim puts in the pictures it writes (PNG Software, GIF and MP4 comment)
 PVD_MARK = "<!-- written by ropesim export -->"

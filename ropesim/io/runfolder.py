@@ -48,12 +48,8 @@ import numpy as np
 
 from .atomic import FILE_MODE, TEMPORARY_NAME, _umask, atomic_output, fsync_path, write_json_atomic
 
-FORMAT = "ropesim run folder 2"
-MANIFEST, LOCK, CHECKPOINT, STATE = "manifest.json", ".lock", "checkpoint", "state.npz"
-TRAJECTORY, SCENE, SUMMARY, LEDGER = "trajectory.npz", "scene.toml", "summary.json", "ledger.npz"
-COMPLETED, BLEW_UP, INTERRUPTED, INCOMPLETE = "completed", "blew_up", "interrupted", "incomplete"
-FINISHED = (COMPLETED, BLEW_UP)
-RUN_MARKERS = (MANIFEST, SCENE, TRAJECTORY, SUMMARY, CHECKPOINT, LEDGER)
+from .layout import (BLEW_UP, CHECKPOINT, COMPLETED, FINISHED, FORMAT, INCOMPLETE, INTERRUPTED, LEDGER, LOCK,
+                     MANIFEST, RUN_MARKERS, SCENE, STATE, SUMMARY, TRAJECTORY)
 HEADER_BYTES = 256          # a stream file's .npy header, padded so that it can be rewritten in place
 VERIFY_BLOCK = 16 * 2 ** 20
 
