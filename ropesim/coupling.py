@@ -423,10 +423,12 @@ class Coupling:
         if self.writer is not None:
             from .io.trajectory import FrameStore
             from .model.tension import frame_arrays
+            from .scene.frame import frame_of
 
             model = self.model
             self._rows = FrameStore(0, model.nodes, model.dim,
-                                    derive=lambda t, x, v, body: frame_arrays(model, t, x, v, body)).rows
+                                    derive=lambda t, x, v, body: frame_arrays(model, t, x, v, body),
+                                    frame=frame_of(model.scene)).rows
             if record_first and self.writer.count == 0:
                 self._record_now()
 
