@@ -199,6 +199,7 @@ def run_content(run) -> RunContent:
     from ..model.build import build
 
     traj = run if isinstance(run, Trajectory) else Trajectory.open(Path(run))
+    traj = traj.internal    # drawn in the y-up frame the model's geometry is in (the viewer's y is up)
     scene = traj.scene
     model = build(scene, solve=False)    # node masses and the marks; the frames hold the shape
     fields = []
