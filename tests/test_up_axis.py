@@ -132,7 +132,7 @@ def test_a_z_up_scene_is_its_y_up_twin_inside_and_writes_back_its_own_frame(twin
     assert written["points"][0]["path_table"] == given["points"][0]["path_table"]
     again = scene_from_toml(S.scene_to_toml(z_scene))
     assert again == z_scene                       # the resolved scene loads back to the same twin, bit for bit
-    assert "up" not in S.scene_to_dict(y_scene)   # a y-up scene's resolved file is as before
+    assert S.scene_to_dict(y_scene)["up"] == "y"     # a y-up scene's resolved file says so, its keys as before
 
 
 def test_a_z_up_run_folder_exports_and_plots_heights_from_z(twins, tmp_path):

@@ -234,8 +234,8 @@ def _parts(scene, into: bool) -> dict:
 def twin_of(scene, base_dir, fail):
     """The y-up twin of a z-up scene read from its file (see the module's docstring), before the checks that
     involve more than one key (they check the twin). A driven path given as a CSV file is read here (its columns
-    are the scene's axes) and kept inline, turned, as ``path_table``; each rigid body keeps the orientation as the
-    file gave it (``frame_orientation``), which the resolved scene writes back exactly."""
+    are the scene's axes) and kept inline, turned, as ``path_table``; the scene keeps its rigid bodies' orientations
+    as the file gave them (``given_orientations``), which the resolved scene writes back exactly."""
     from dataclasses import replace
 
     from .motion import read_path
@@ -257,8 +257,7 @@ def twin_of(scene, base_dir, fail):
         if body.kind == "driven":
             _check_driven_turns(body, f"bodies.{j}", fail)
     twin = replace(scene, **_parts(scene, into=True))
-    return replace(twin, rigid_bodies=tuple(replace(b, frame_orientation=given.orientation) for b, given in
-                                            zip(twin.rigid_bodies, scene.rigid_bodies)))
+    return replace(twin, given_orientations=tuple(b.orientation for b in scene.rigid_bodies))
 
 
 def scene_out(scene):
@@ -269,9 +268,18 @@ def scene_out(scene):
     if not frame_of(scene).turned:
         return scene
     turned = replace(scene, **_parts(scene, into=False))
-    bodies = tuple(b if twin.frame_orientation is None else replace(b, orientation=twin.frame_orientation)
-                   for b, twin in zip(turned.rigid_bodies, scene.rigid_bodies))
+    given = scene.given_orientations
+    if len(given) != len(scene.rigid_bodies):
+        return turned
+    bodies = tuple(replace(b, orientation=g) if g is not None and b.orientation is not None and
+                   _same_rotation(g, twin.orientation) else b
+                   for b, twin, g in zip(turned.rigid_bodies, scene.rigid_bodies, given))
     return replace(turned, rigid_bodies=bodies)
+
+
+def _same_rotation(given, twin) -> bool:
+    """True when the file's angles ``given`` still turn into the twin's ``twin`` (a body not changed since)."""
+    return tuple(orientation_turn(given, into=True)) == tuple(twin)
 
 
 def _check_driven_turns(body, key: str, fail) -> None:

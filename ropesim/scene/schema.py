@@ -484,9 +484,6 @@ class RigidBody:
                                                 "freedom]", "s, m, deg", default=None, required=False)
     ramp_time: float | None = spec("float", "driven: time over which the sinusoid and the path ramp in (0: at once)",
                                    "s", default=None, required=False, low=0)
-    frame_orientation: tuple | None = field(default=None, compare=False, repr=False)
-    """A z-up scene's body: its orientation as the scene file gave it (``orientation`` is the y-up twin's), written
-    back as it was (:mod:`ropesim.scene.frame`)."""
 
     @property
     def moving(self) -> bool:
@@ -760,6 +757,9 @@ class Scene:
     output: Output = Output()
     description: str = ""
     up: str = "y"
+    given_orientations: tuple = field(default=(), compare=False, repr=False)
+    """A z-up scene's rigid bodies' orientations as its file gave them (the bodies hold their y-up twins'), written
+    back as they were (:mod:`ropesim.scene.frame`)."""
     gravity: Gravity | None = None
     drag: Drag | None = None
     fluid: Fluid | None = None
@@ -864,8 +864,7 @@ def scene_to_dict(scene: Scene) -> dict:
     if scene.description:
         out["description"] = scene.description
     out["dimension"] = scene.dimension
-    if scene.up != "y":
-        out["up"] = scene.up
+    out["up"] = scene.up
     for key in TABLES:
         part = getattr(scene, key)
         if part is not None:
