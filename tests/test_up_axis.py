@@ -237,3 +237,24 @@ def test_load_scene_reads_up_from_a_file(tmp_path):
     path = tmp_path / "z.toml"
     path.write_text(tomli_w.dumps(to_z_up(y_up_scene())))
     assert load_scene(path).up == "z"
+
+
+def test_a_moordyn_import_as_it_is_is_the_importers_y_up_form_inside():
+    """MoorDyn's file imported as it is (up = "z", the default) and as the importer turns it into ropesim's y-up
+    frame (``y_up=True``, its own rotation of every key) are the same scene inside: every key equal, the body's
+    angles but for the importer's rounding to 12 decimals (a free body turned by roll, pitch and yaw on one line
+    to an anchor over the seabed). (Their runs start from the static solve, which leaves the nodes resting on the
+    frictionless seabed free to lie anywhere along it: the rounding moves them by up to 9 mm, so the run comparison
+    is the twin test above.)"""
+    from dataclasses import replace
+
+    from ropesim.scene.moordyn import read_moordyn
+    from test_moordyn_import import BODY
+
+    z_scene, y_scene = (scene_from_dict({"name": "body", **read_moordyn(BODY, "body.txt", y_up=y_up).scene})
+                        for y_up in (False, True))
+    assert z_scene.up == "z" and y_scene.up == "y"
+    z_body, y_body = z_scene.rigid_bodies[0], y_scene.rigid_bodies[0]
+    np.testing.assert_allclose(z_body.orientation, y_body.orientation, rtol=0, atol=1e-11)
+    assert replace(z_scene, up="y", rigid_bodies=(replace(z_body, orientation=y_body.orientation),)) == y_scene
+    assert S.scene_to_dict(z_scene)["points"] == read_moordyn(BODY, "body.txt").scene["points"]   # written back as given
