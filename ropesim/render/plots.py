@@ -73,7 +73,8 @@ def draw_energy(ax, traj: Trajectory, model: Model) -> None:
         else:
             ax.plot(traj.t, values, linewidth=1.1, label=name)
     ax.set_ylabel("energy [J]")
-    ax.set_title("Mechanical energy (gravity: m g y, zero at y = 0)")
+    up = "z" if model.scene.up == "z" else "y"
+    ax.set_title(f"Mechanical energy (gravity: m g {up}, zero at {up} = 0)")
     ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
 
