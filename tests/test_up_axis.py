@@ -258,3 +258,29 @@ def test_a_moordyn_import_as_it_is_is_the_importers_y_up_form_inside():
     np.testing.assert_allclose(z_body.orientation, y_body.orientation, rtol=0, atol=1e-11)
     assert replace(z_scene, up="y", rigid_bodies=(replace(z_body, orientation=y_body.orientation),)) == y_scene
     assert S.scene_to_dict(z_scene)["points"] == read_moordyn(BODY, "body.txt").scene["points"]   # written back as given
+
+
+def test_a_z_up_rope_hangs_along_z_and_starts_again_from_its_own_run(tmp_path):
+    """A 3-D rope of a z-up scene hangs along -z from its pinned top and swings in x; another z-up scene starts from
+    its last frame (initial.shape = "from_run" reads the run's frames, which are in the scene's frame); a y-up scene
+    starting from it is refused in one line."""
+    import tomli_w
+
+    rope = {"name": "hang", "dimension": 3, "up": "z",
+            "rope": {"nodes": 5, "segment_length": 0.5, "stiffness": 2000.0, "mass": 0.1},
+            "initial": {"shape": "hanging", "top": [0.0, 1.0, 3.0], "velocity": [0.5, 0.0, 0.0]},
+            "pinned": {"nodes": [0]}, "gravity": {},
+            "integrator": {"dt": 1e-4, "t_end": 0.2, "method": "verlet"}, "output": {"interval": 0.1}}
+    traj = simulate(scene_from_dict(rope), tmp_path / "hang")
+    np.testing.assert_allclose(traj.x[0, :, 2], 3.0 - 0.5 * np.arange(5), rtol=0, atol=1e-12)   # down along z
+    np.testing.assert_array_equal(traj.x[0, :, 1], 1.0)
+    assert traj.x[-1, -1, 0] > 0.0 and traj.x[-1, -1, 2] < traj.x[-1, 0, 2]
+    again = dict(rope, initial={"shape": "from_run", "run": "hang"})
+    path = tmp_path / "again.toml"
+    path.write_text(tomli_w.dumps(again))
+    scene = load_scene(path)
+    written = S.scene_to_dict(scene)
+    np.testing.assert_array_equal(np.array(written["initial"]["points"]), traj.x[-1])    # the frame, in z up
+    path.write_text(tomli_w.dumps({k: v for k, v in again.items() if k != "up"}))
+    with pytest.raises(SceneError, match="initial.run: .*up = 'z' and this scene has up = 'y'"):
+        load_scene(path)
