@@ -157,6 +157,9 @@ def test_a_z_up_run_folder_exports_and_plots_heights_from_z(twins, tmp_path):
     assert ("x [m]", "y [m]", "z [m]") in labels                    # the 3-D shape: z up, labelled so
     internal = opened.internal
     np.testing.assert_array_equal(internal.x[..., 1], opened.x[..., 2])   # the model's height is the scene's z
+    from ropesim.viewer.content import run_content
+
+    assert run_content(opened).axes == ("x", "z", "-y")     # the viewer draws y-up, its triad names the scene's axes
 
 
 def test_every_geometric_key_of_the_schema_says_how_it_turns():
