@@ -176,6 +176,7 @@ def test_every_geometric_key_of_the_schema_says_how_it_turns():
     (lambda raw: raw.update(up="x"), "up", "one of 'y', 'z'"),
     (lambda raw: raw["bodies"][0].update(kind="driven", angular_velocity=[0.0, 1.0, 0.0],
                                          orientation=[0.0, 0.0, 5.0]), "bodies.0", "at most one of y and z"),
+    (lambda raw: raw["seabed"].update(height=-300.0), "seabed.height", "at z = -320 m"),   # checked on the twin
 ])
 def test_bad_up_is_refused_in_one_line(change, key, words):
     raw = to_z_up(y_up_scene())

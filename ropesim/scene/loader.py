@@ -376,7 +376,8 @@ def _check_seabed(scene: S.Scene, fail) -> None:
         if bed.contact_width is None and bare:
             fail("seabed.contact_width", f"missing: the seabed pushes on a footprint contact_width x node length; "
                                          f"give it, or every line's diameter (lines.{bare[0]} has none)")
-        held = [(f"{p.kind} point '{p.id}' (points.{j}, at y = {p.position[1]:.6g} m)", p.position[0], p.position[1])
+        held = [(f"{p.kind} point '{p.id}' (points.{j}, at {scene.up} = {p.position[1]:.6g} m)", p.position[0],
+                 p.position[1])
                 for j, p in enumerate(scene.points) if p.kind in (*S.STILL_KINDS, "driven")]
     else:
         if bed.contact_width is None and scene.rope.diameter is None:
@@ -386,7 +387,7 @@ def _check_seabed(scene: S.Scene, fail) -> None:
 
         x = initial_positions(scene)   # the held nodes where the scene puts them (the sagging guess keeps its ends)
         nodes = set(scene.pinned.nodes if scene.pinned else ()) | {i for d in scene.driven for i in d.nodes}
-        held = [(f"held node {i} (at y = {x[1][i]:.6g} m)", x[0][i], x[1][i])
+        held = [(f"held node {i} (at {scene.up} = {x[1][i]:.6g} m)", x[0][i], x[1][i])
                 for i in sorted(scene.node(i) for i in nodes)]
     slope = math.radians(bed.slope)
     for what, x, y in held:
@@ -535,8 +536,9 @@ def _check_flow_covers_the_start(scene: S.Scene, fail) -> None:
         y, what, whose = initial_positions(scene)[1], "rope starts", "rope"
     low, high = float(min(y)), float(max(y))
     if low < flow.heights[0] or high > flow.heights[-1]:
-        fail("flow.heights", f"cover y = {flow.heights[0]:g} to {flow.heights[-1]:g} m, but the {what} at "
-                             f"y = {low:g} to {high:g} m; extend the table to the {whose}'s range")
+        up = scene.up    # the twin's y is the height, named as the scene names it
+        fail("flow.heights", f"cover {up} = {flow.heights[0]:g} to {flow.heights[-1]:g} m, but the {what} at "
+                             f"{up} = {low:g} to {high:g} m; extend the table to the {whose}'s range")
 
 
 def _check_name_and_length(scene: S.Scene, fail) -> None:
