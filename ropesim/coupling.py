@@ -9,7 +9,8 @@ the step's end. A coupled body moves its points rigidly, as a driven body does (
 its pose is its reference point and its angles about x, then y, then z (R = Rz Ry Rx), and the caller gives the
 angles' rates with its velocity.
 
-Degrees of freedom, in the scene's frame and in the scene's order of ``[[bodies]]`` then ``[[points]]`` (MoorDyn
+Degrees of freedom, in ropesim's y-up frame (a z-up scene, ``up = "z"``, is coupled in its y-up twin's frame,
+(x, y, z) -> (x, z, -y): turn its coordinates so, as :mod:`ropesim.compat.moordyn` does) and in the scene's order of ``[[bodies]]`` then ``[[points]]`` (MoorDyn
 too lists coupled bodies before coupled points): a coupled body has 6 in 3-D (x, y, z [m], then the angles
 about x, y, z [rad]) and 3 in 2-D (x, y, the angle about z); a coupled point has one per axis. The forces come
 in the same layout: a body's force [N] on its reference point and the moment [N m] about it (world axes), a
@@ -423,10 +424,12 @@ class Coupling:
         if self.writer is not None:
             from .io.trajectory import FrameStore
             from .model.tension import frame_arrays
+            from .scene.frame import frame_of
 
             model = self.model
             self._rows = FrameStore(0, model.nodes, model.dim,
-                                    derive=lambda t, x, v, body: frame_arrays(model, t, x, v, body)).rows
+                                    derive=lambda t, x, v, body: frame_arrays(model, t, x, v, body),
+                                    frame=frame_of(model.scene)).rows
             if record_first and self.writer.count == 0:
                 self._record_now()
 

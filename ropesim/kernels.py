@@ -76,13 +76,15 @@ def warm_up(scene) -> None:
     from .model.build import build
     from .model.tension import frame_arrays
     from .run import INTERRUPTED, simulate
+    from .scene.frame import frame_of
     from .stop import Stopped
 
     short = one_step(scene)
     model = build(short)                  # a scene starting in equilibrium runs (and compiles) the static solver
     integrator = make_integrator(model, TimeGrid.of(short))
     integrator.warm_up()                  # the loop, outside the run's signal handling: Ctrl-C stops it
-    store = FrameStore(0, model.nodes, model.dim, derive=lambda t, x, v, body: frame_arrays(model, t, x, v, body))
+    store = FrameStore(0, model.nodes, model.dim, derive=lambda t, x, v, body: frame_arrays(model, t, x, v, body),
+                       frame=frame_of(model.scene))
     store.rows(np.zeros(1), integrator.x[None], integrator.v[None], None, integrator.body_rows()[None])   # as the run derives its frames
     summary = simulate(short).summary
     if summary["status"] == INTERRUPTED:

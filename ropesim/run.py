@@ -348,10 +348,12 @@ def _manifest_info(scene: Scene, grid: TimeGrid) -> dict:
 def _run_in_memory(model: Model, grid: TimeGrid, progress: bool, stop, before_bar=None) -> "Trajectory":
     from .io.trajectory import FrameStore
     from .model.tension import frame_arrays
+    from .scene.frame import frame_of
 
     specs = frame_specs(model)
     store = FrameStore(grid.frames, model.nodes, model.dim, derive=lambda t, x, v, body: frame_arrays(model, t, x, v, body),
-                       shapes={k: s for k, s in specs.items() if k not in ("t", "x", "v", "ledger")})
+                       shapes={k: s for k, s in specs.items() if k not in ("t", "x", "v", "ledger")},
+                       frame=frame_of(model.scene))
     with _progress(progress, model.scene, before_bar) as on_progress:
         outcome = integrate(model, store, on_progress, stop=stop)
     return _in_memory(model, store.arrays(), outcome)
@@ -386,9 +388,11 @@ class _DiskStore:
 
         from .io.trajectory import FrameStore
         from .model.tension import frame_arrays
+        from .scene.frame import frame_of
 
         self.writer, self.seconds = writer, seconds
-        self.rows = FrameStore(0, model.nodes, model.dim, derive=lambda t, x, v, body: frame_arrays(model, t, x, v, body)).rows
+        self.rows = FrameStore(0, model.nodes, model.dim, derive=lambda t, x, v, body: frame_arrays(model, t, x, v, body),
+                               frame=frame_of(model.scene)).rows
         self.last = -float("inf")
         self.wall0 = float(previous.get("wall_time_s", 0.0))
         self.compile0 = float(previous.get("compile_time_s", 0.0))

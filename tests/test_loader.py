@@ -196,7 +196,7 @@ def test_misspelt_key_in_the_held_and_force_parts(dotted, near, extra):
 
 
 def test_unknown_key_without_a_near_one_lists_what_is_allowed():
-    text = refused(variant(LINE, zzzz=1), "zzzz", "allowed: name, description, dimension, rope, initial")
+    text = refused(variant(LINE, zzzz=1), "zzzz", "allowed: name, description, dimension, up, rope, initial")
     assert "did you mean" not in text
     refused(variant(LINE, rope__qqqq=1), "rope.qqqq", "allowed: nodes, segment_length, stiffness, mass, closed")
 

@@ -158,7 +158,7 @@ def test_each_imported_file_runs_a_few_steps_from_its_statics(name):
 def test_lines_txt_statics_agree_with_moordyns_own():
     """OC3-Hywind's three chains, their fairleads held: each line's fairlead and anchor tension within 1e-5 of
     MoorDyn's (the issue asks 0.2 %; MoorDyn's relaxation stops about 2e-6 short, see the reference), and every node
-    within 2 mm of MoorDyn's (of a 902 m line), after the frame's rotation (x, y, z) -> (x, z, -y)."""
+    within 2 mm of MoorDyn's (of a 902 m line), in MoorDyn's own frame (the imported scene is z-up)."""
     stored = json.loads((DATA / "import" / "lines_statics.json").read_text())
     scene = load_scene(MOORING / "lines.txt", ["integrator.t_end=0.002", "output.interval=0.002"])
     traj = ropesim.simulate(scene)
@@ -166,7 +166,7 @@ def test_lines_txt_statics_agree_with_moordyns_own():
         line = traj.line(line_id)
         assert line.tension[0, -1] == pytest.approx(figures["fairlead_tension_N"], rel=1e-5)
         assert line.tension[0, 0] == pytest.approx(figures["anchor_tension_N"], rel=1e-5)
-        moordyn = np.array([[x, z, -y] for x, y, z in figures["nodes_m"]])
+        moordyn = np.array(figures["nodes_m"])
         assert np.max(np.linalg.norm(line.positions[0] - moordyn, axis=1)) < 2e-3
 
 
@@ -176,7 +176,8 @@ def test_the_imported_scene_carries_moordyns_numbers_and_says_where_laws_differ(
     assert scene["line_types"]["main"] == {"diameter": 0.09, "mass_per_length": 77.7066, "EA": 384.243e6,
                                            "axial_damping_ratio": 0.8, "cd_normal": 1.6, "ca_normal": 1.0,
                                            "cd_tangential": 0.1, "ca_tangential": 0.0}
-    assert scene["points"][1] == {"id": "point2", "kind": "fixed", "position": [-426.94, -320.0, -739.47]}
+    assert scene["up"] == "z"      # MoorDyn's numbers as its file gives them
+    assert scene["points"][1] == {"id": "point2", "kind": "fixed", "position": [-426.94, 739.47, -320.0]}
     assert [p["kind"] for p in scene["points"]] == ["fixed"] * 3 + ["coupled"] * 3
     assert scene["seabed"] == {"height": -320.0, "stiffness": 3.0e6, "damping": 3.0e5, "damping_both_ways": True}
     assert scene["gravity"] == {"g": 9.80665} and scene["fluid"] == {"density": 1025.0}

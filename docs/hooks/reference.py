@@ -51,6 +51,7 @@ WHEN_ABSENT = {
     "name": "the file's stem",
     "description": '`""`',
     "dimension": "`2`",
+    "up": '`"y"`',
     "initial.top": "the origin",
     "initial.top_center": "the thrower's `center`",
     "initial.velocity": "zero",

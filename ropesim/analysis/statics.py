@@ -93,6 +93,25 @@ class StaticShape:
     points: tuple[PointFigures, ...] = ()   # a system's points (a rope: none)
     bodies: tuple[BodyFigures, ...] = ()    # a system's rigid bodies (free ones at their static poses)
 
+    def in_scene_frame(self) -> "StaticShape":
+        """These figures in the scene's own frame (a z-up scene's turned out of its y-up twin, as its runs' outputs
+        are: :mod:`ropesim.scene.frame`); the shape itself for a y-up scene."""
+        from dataclasses import replace
+
+        from .rotation import angles_from_quaternion
+        from ..scene.frame import frame_of
+
+        frame = frame_of(self.model.scene)
+        if not frame.turned:
+            return self
+        out = frame.out
+        points = tuple(replace(p, position=out(p.position), force=out(p.force)) for p in self.points)
+        bodies = tuple(replace(b, position=out(b.position), quaternion=frame.quaternion_out(b.quaternion),
+                               angles=angles_from_quaternion(frame.quaternion_out(b.quaternion)),
+                               line_forces={k: out(f) for k, f in b.line_forces.items()},
+                               line_moments={k: out(m) for k, m in b.line_moments.items()}) for b in self.bodies)
+        return replace(self, x=out(self.x), supports=out(self.supports), points=points, bodies=bodies)
+
 
 def equilibrium(scene: S.Scene) -> StaticShape:
     """Solve ``scene``'s static shape from its initial shape (an ``equilibrium`` start from its sagging guess)."""

@@ -47,8 +47,13 @@ def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray
               tension: np.ndarray | None = None, bodies: dict | None = None) -> dict:
     """Everything a user wants to know about a finished (or stopped) run, as JSON-ready values; with the frames'
     ``tension`` (F, S) also the tension at both ends and the largest (see :mod:`ropesim.analysis.tension`);
-    ``bodies`` the rigid bodies' per-frame arrays (body_x, ...), for the energy ledger."""
+    ``bodies`` the rigid bodies' per-frame arrays (body_x, ...), for the energy ledger. The arrays are stored in
+    the scene's own frame (:mod:`ropesim.scene.frame`); the figures are computed in the model's y-up one."""
+    from ..scene.frame import frame_of
+
     scene = model.scene
+    frame = frame_of(scene)
+    x, v, bodies = frame.into(x), frame.into(v), None if bodies is None else frame.arrays_into(bodies)
     grid = outcome.grid
     node_steps = outcome.steps * model.nodes
     summary: dict = {

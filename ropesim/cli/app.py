@@ -541,9 +541,9 @@ def equilibrium(
     with _compiling():   # the static solver compiles on its first use
         shape = solve(scene)
     if as_json:
-        _echo_json(equilibrium_data(shape, where))
+        _echo_json(equilibrium_data(shape.in_scene_frame(), where))
     else:
-        print_equilibrium(shape, where)
+        print_equilibrium(shape.in_scene_frame(), where)
     if not shape.converged:
         fail(f"{where}: the static solve did not converge (largest residual force {shape.residual:.3g} N after "
              f"{shape.iterations} iterations); check that the rope can hang where the scene holds it", 1)

@@ -168,8 +168,11 @@ def print_check(scene: Scene, source: Path) -> None:
     from ..model.build import build
     from ..integrate.grid import TimeGrid
 
+    from ..scene.frame import scene_out
+
     model = build(scene)
     grid = TimeGrid.of(scene)
+    scene = scene_out(scene)    # shown in its own frame (a z-up scene's keys as its file gives them)
     table = Table(title=f"{source}: valid scene '{scene.name}'", show_header=False, title_justify="left")
     table.add_column("", style="bold")
     table.add_column("", overflow="fold")  # words wrap; a word too long for the column folds, never cut
@@ -177,6 +180,9 @@ def print_check(scene: Scene, source: Path) -> None:
         table.add_row("description", scene.description)
     for key, value in (system_rows(scene, model) if scene.is_system else rope_rows(scene)):
         table.add_row(key, value)
+    if scene.up == "z":
+        table.add_row("frame", "z up (up = \"z\"): computed in its y-up twin, (x, y, z) -> (x, z, -y); every output in "
+                               "this frame")
     init = scene.initial
     if scene.is_system:
         table.add_row("initial", f"{init.shape}: " + ("every line straight or sagging from its start point to its "
@@ -552,11 +558,14 @@ def check_data(scene: Scene, source) -> dict:
     from ..integrate.grid import TimeGrid
     from ..model.build import build
 
+    from ..scene.frame import scene_out
+
     model = build(scene)
     grid = TimeGrid.of(scene)
+    scene = scene_out(scene)    # in its own frame (a z-up scene's keys as its file gives them)
     omega_gershgorin, omega, rows = bounds(model)
     out = {"source": str(source), "valid": True, "scene": scene.name, "description": scene.description,
-           "dimension": scene.dimension, "nodes": model.nodes}
+           "dimension": scene.dimension, "up": scene.up, "nodes": model.nodes}
     if scene.is_system:
         out.update(system_data(scene, model))
     else:

@@ -61,9 +61,9 @@ class System:
             raise CouplingError(f"{scene.name}: MoorDyn's calls move 3-D systems; this scene is 2-D")
         self.coupling = Coupling(scene)
         self.scene = scene
-        up = getattr(scene, "up", "y")
-        # P turns MoorDyn's (z-up) coordinates into the scene's: y up (x, y, z) -> (x, z, -y); z up: itself
-        self.turn = np.eye(3) if up == "z" else np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])
+        # P turns MoorDyn's (z-up) coordinates into the coupling's, ropesim's y-up frame, (x, y, z) -> (x, z, -y),
+        # whatever the scene's up: a z-up scene (up = "z") computes, and is coupled, in its y-up twin
+        self.turn = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])
         self.last_x = self.last_v = None
         self.forces = None
 

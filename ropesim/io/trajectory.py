@@ -13,6 +13,7 @@ checking every frame's CRC-32 first.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -33,17 +34,19 @@ class FrameStore:
     Named per-frame arrays: ``t``, ``x``, ``v``, ``ledger`` (the energy ledger's flows), and with ``derive`` (a
     function of the frames' t (k,), x and v (k, N, D) and the free bodies' states (k, 13, B) or None, returning
     named (k, ...) arrays, ``shapes`` their per-frame shapes) what it derives: the segments' tension and strain,
-    the supports' forces, the rigid bodies' poses (:mod:`ropesim.model.tension`).
+    the supports' forces, the rigid bodies' poses (:mod:`ropesim.model.tension`). With ``frame`` (a z-up scene's
+    :class:`ropesim.scene.frame.Frame`) the vectors are stored in the scene's own frame.
     """
 
     def __init__(self, n_frames: int, nodes: int, dim: int, folder: Path | None = None, derive=None,
-                 shapes: dict[str, tuple] | None = None, ledger_columns: int | None = None):
+                 shapes: dict[str, tuple] | None = None, ledger_columns: int | None = None, frame=None):
         from ..integrate.health import LEDGER_COLUMNS
 
         if folder is not None:
             raise TypeError("FrameStore keeps frames in memory; a run folder is written by ropesim.simulate")
         self.count = 0
         self.derive = derive
+        self.frame = frame     # a z-up scene's frames are stored turned out of its y-up twin (ropesim.scene.frame)
         self.specs = {"t": (), "x": (nodes, dim), "v": (nodes, dim), **(shapes or {}),
                       "ledger": (ledger_columns or len(LEDGER_COLUMNS),)}
         self.names = tuple(self.specs)
@@ -64,7 +67,7 @@ class FrameStore:
         if self.derive is not None:
             out.update(self.derive(out["t"], x, v, body))
         out["ledger"] = np.zeros((len(t), self.specs["ledger"][0])) if ledger is None else ledger
-        return out
+        return out if self.frame is None else self.frame.arrays_out(out)
 
     def append(self, t: np.ndarray, x_dn: np.ndarray, v_dn: np.ndarray, ledger: np.ndarray | None = None,
                body: np.ndarray | None = None) -> None:
@@ -101,6 +104,9 @@ class Trajectory:
     angular velocity in world axes (2-D: about z alone), every body in the scene's order (None without rigid
     bodies). :meth:`line`, :meth:`point` and :meth:`body` give each object's results by its id.
 
+    Every array is in the scene's own frame: a z-up scene's (``up = "z"``) are z-up, though the model computes
+    in its y-up twin (:mod:`ropesim.scene.frame`; :attr:`internal` gives the run in that frame).
+
     From :func:`ropesim.simulate` the arrays are in memory; from :meth:`open` they are memory-mapped.
     """
 
@@ -123,6 +129,24 @@ class Trajectory:
     @property
     def frames(self) -> int:
         return len(self.t)
+
+    @property
+    def frame(self):
+        """The scene's own frame (:class:`ropesim.scene.frame.Frame`): which axis is up. Every array here is in it."""
+        from ..scene.frame import frame_of
+        return frame_of(self.scene)
+
+    @cached_property
+    def internal(self) -> "Trajectory":
+        """This run in ropesim's y-up frame, the frame its scene object and model compute in (the trajectory itself
+        for a y-up scene; for a z-up one a copy with every vector turned into its y-up twin's frame): what the
+        analyses and pictures that use the model's geometry (heights, the seabed) read."""
+        frame = self.frame
+        if not frame.turned:
+            return self
+        from dataclasses import replace
+        arrays = frame.arrays_into({name: getattr(self, name) for name in ("x", "v", *DERIVED)})
+        return replace(self, **arrays)
 
     @property
     def nodes(self) -> int:

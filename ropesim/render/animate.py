@@ -112,7 +112,7 @@ class FrameRenderer3D:
         top = (22 + (16 if legend_handles(model) else 0)) / height
         box = run_box(traj.x, nodes, getattr(traj, "body_x", None))
         self.ax = axes_3d(fig, [0.02, 0.02, 0.96, 0.96 - top], box, nodes is not None,
-                          azim=azimuth(model, np.asarray(traj.x[0])))
+                          azim=azimuth(model, np.asarray(traj.x[0])), up=model.scene.up)
         picture_title(fig, model, VIEW_3D)
         self.geometry = Geometry3D(self.ax, model, box)
         self.state = State3D(self.ax, model)
@@ -183,9 +183,11 @@ def animate(traj: Frames, out: str | Path, *, fps: float = 25.0, speed: float = 
         if fps > GIF_MAX_FPS:
             remarks.append(f"a GIF plays at most {GIF_MAX_FPS:g} fps: using {rate:g} (write an .mp4 for more)")
     plan = animation_plan(traj.t, rate, speed, start, end)
+    frame = getattr(traj, "frame", None)
+    traj = getattr(traj, "internal", traj)    # drawn in the y-up frame the model's geometry is in
     model = build(traj.scene, solve=False)   # the frames hold the shape: no static solve
     three_d = wants_3d(view, traj.scene)
-    proj = None if three_d else projection(view, traj.scene.dimension)
+    proj = None if three_d else projection(view, traj.scene.dimension, frame)
     if three_d and traj.scene.dimension != 3:
         raise RenderError(f"--view {view}: the 3-D view is for 3-D scenes; this one is {traj.scene.dimension}-D "
                           f"(its view is xy)")

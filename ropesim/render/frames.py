@@ -68,6 +68,8 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
         raise RenderError(f"--columns {columns}: must be at least 1")
     if width is not None and width < 200:
         raise RenderError(f"--width {width}: must be at least 200 px")
+    frame = traj.frame
+    traj = traj.internal                     # drawn in the y-up frame the model's geometry is in
     model = build(traj.scene, solve=False)   # the frames hold the shape: no static solve
     nodes = followed_nodes(model, follow)
     if wants_3d(view, traj.scene):
@@ -75,7 +77,7 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
             raise RenderError(f"--view {view}: the 3-D view is for 3-D scenes; this one is "
                               f"{traj.scene.dimension}-D (its view is xy)")
         return _sheet_3d(traj, model, real, out, indices, nodes, overlay, columns, width)
-    proj = projection(view, traj.scene.dimension)
+    proj = projection(view, traj.scene.dimension, frame)
     box = view_box(model, traj.x, proj, nodes, traj.body_x)
     aspect = view_aspect(box)
     box = fit_box(box, 1.0, aspect)
@@ -154,7 +156,7 @@ def _sheet_3d(traj, model, real, out, indices, nodes, overlay, columns, width) -
         from matplotlib import colormaps
         from matplotlib.lines import Line2D
 
-        ax = axes_3d(fig, grid[0, 0], box, nodes is not None, azim=azim)
+        ax = axes_3d(fig, grid[0, 0], box, nodes is not None, azim=azim, up=model.scene.up)
         geometry = Geometry3D(ax, model, box)
         if shifts[-1] is not None:
             geometry.move(shifts[-1])
@@ -167,7 +169,7 @@ def _sheet_3d(traj, model, real, out, indices, nodes, overlay, columns, width) -
         ax.legend(handles=handles, fontsize=7, **OUTSIDE_RIGHT)
     else:
         for k, ((x, state), shift, t) in enumerate(zip(frames, shifts, shown)):
-            ax = axes_3d(fig, grid[k // cols, k % cols], box, nodes is not None, fontsize=7, azim=azim)
+            ax = axes_3d(fig, grid[k // cols, k % cols], box, nodes is not None, fontsize=7, azim=azim, up=model.scene.up)
             geometry = Geometry3D(ax, model, box)
             if shift is not None:
                 geometry.move(shift)

@@ -1,7 +1,9 @@
 """Where the picture looks: the projection, the followed node, the scene's fixed outline, and view limits.
 
 A 2-D scene is drawn as it is (x across, y up). A 3-D scene is drawn projected on two of its axes, chosen by
-``view`` ("xy": side view, y up; "xz": from above; "zy": from the front; the first letter runs across).
+``view`` ("xy": side view, y up; "xz": from above; "zy": from the front; the first letter runs across; in a z-up
+scene "xz" is the side view and "xy" the view from above). Pictures are drawn from the run in ropesim's y-up frame
+(:attr:`ropesim.Trajectory.internal`), labelled with the scene's own axes.
 With ``follow`` every position is taken relative to the driven nodes' centre, the view from the helicopter.
 Limits are fixed from the whole run, read in blocks of frames so a long run is never loaded at once.
 """
@@ -28,20 +30,29 @@ class Projection:
     """Which scene axes run across (``axes[0]``) and up (``axes[1]``) the picture."""
 
     axes: tuple[int, int]
+    labels: tuple[str, str] | None = None   # the scene's own names of the axes (a z-up scene's), if not x, y, z
 
     @property
     def names(self) -> tuple[str, str]:
-        return AXIS_NAMES[self.axes[0]], AXIS_NAMES[self.axes[1]]
+        return self.labels or (AXIS_NAMES[self.axes[0]], AXIS_NAMES[self.axes[1]])
 
 
-def projection(view: str | None, dim: int) -> Projection:
-    """The projection for ``view`` (default "xy") on a ``dim``-dimensional scene."""
-    view = "xy" if view is None else view.strip().lower()
+def projection(view: str | None, dim: int, frame=None) -> Projection:
+    """The projection for ``view`` (default "xy", the side view; "xz" in a z-up scene) on a ``dim``-dimensional
+    scene, whose frames are drawn in ropesim's y-up frame. In a z-up scene (``frame``) the view names the scene's
+    own axes: x, z (up, the y-up frame's y) and y (the y-up frame's -z: a view across y is labelled -y)."""
+    turned = frame is not None and frame.turned
+    view = ("xz" if turned else "xy") if view is None else view.strip().lower()
     allowed = AXIS_NAMES[:dim]
     if len(view) != 2 or view[0] == view[1] or any(c not in allowed for c in view):
-        example = "xy (side view), xz (from above) or zy (from the front), or 3d for a 3-D view" if dim == 3 else "xy"
+        side, above, front = ("xz", "xy", "yz") if turned else ("xy", "xz", "zy")
+        example = (f"{side} (side view), {above} (from above) or {front} (from the front), or 3d for a 3-D view"
+                   if dim == 3 else "xy")
         raise RenderError(f"--view {view}: choose two different axes of this {dim}-D scene from "
                           f"{', '.join(allowed)}, e.g. {example}")
+    if turned:
+        axes = ("xzy".index(view[0]), "xzy".index(view[1]))
+        return Projection(axes, (frame.axis_name(axes[0]), frame.axis_name(axes[1])))
     return Projection((allowed.index(view[0]), allowed.index(view[1])))
 
 

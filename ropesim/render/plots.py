@@ -73,7 +73,8 @@ def draw_energy(ax, traj: Trajectory, model: Model) -> None:
         else:
             ax.plot(traj.t, values, linewidth=1.1, label=name)
     ax.set_ylabel("energy [J]")
-    ax.set_title("Mechanical energy (gravity: m g y, zero at y = 0)")
+    up = "z" if model.scene.up == "z" else "y"
+    ax.set_title(f"Mechanical energy (gravity: m g {up}, zero at {up} = 0)")
     ax.legend(fontsize=7, **OUTSIDE_RIGHT)
 
 
@@ -213,7 +214,9 @@ def draw_shape(ax, traj: Trajectory, model: Model) -> None:
     if ax.name == "3d":
         _draw_shape_3d(ax, traj, model, i)
         return
-    proj = projection(None, model.dim)
+    from ..scene.frame import frame_of
+
+    proj = projection(None, model.dim, frame_of(model.scene))
     Geometry(ax, model, proj)
     RopeArtist(ax, model, proj, color="0.82").show(np.asarray(traj.x[0]), None, body_state(traj, 0))
     shown = RopeArtist(ax, model, proj)
@@ -256,7 +259,7 @@ def shape_axes(fig, spec, traj: Trajectory, model: Model):
     from .view3d import axes_3d, azimuth, run_box
 
     box = run_box(traj.x, None, traj.body_x)
-    ax = axes_3d(fig, spec, box, False, azim=azimuth(model, np.asarray(traj.x[0])))
+    ax = axes_3d(fig, spec, box, False, azim=azimuth(model, np.asarray(traj.x[0])), up=model.scene.up)
     ax.scene_box = box
     return ax
 
@@ -360,6 +363,8 @@ def run_figure(traj: Trajectory, start: float | None = None, stop: float | None 
     except ValueError as exc:
         raise RenderError(str(exc)) from None
     model = build(traj.scene, solve=False)   # the frames hold the shape: no static solve
+    own = traj             # the body panels plot the run in the scene's own frame; the others in the model's
+    traj = traj.internal
     panels = [p for p in PANELS if p.applies(model) and (traj.tension is not None or not p.needs_tension)
               and (traj.body_x is not None or not p.needs_bodies)]
     rows = [panel.rows(model) for panel in panels]
@@ -368,7 +373,7 @@ def run_figure(traj: Trajectory, start: float | None = None, stop: float | None 
     grid = fig.add_gridspec(len(panels), 1, height_ratios=rows)
     for k, panel in enumerate(panels):
         ax = (panel.axes or (lambda fig, spec, traj, model: fig.add_subplot(spec)))(fig, grid[k, 0], traj, model)
-        panel.draw(ax, traj, model)
+        panel.draw(ax, own if panel.needs_bodies else traj, model)
         if panel.time_axis:
             ax.set_xlabel("t [s]")
             if traj.t[-1] > traj.t[0]:

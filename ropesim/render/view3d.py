@@ -83,9 +83,12 @@ def azimuth(model: Model, x0: np.ndarray) -> float:
     return float(AZIMUTHS[int(np.argmax(apart.min(axis=1)))])
 
 
-def axes_3d(fig, rect_or_spec, box: np.ndarray, follow: bool, fontsize: float = 8, azim: float = -60.0):
+def axes_3d(fig, rect_or_spec, box: np.ndarray, follow: bool, fontsize: float = 8, azim: float = -60.0,
+            up: str = "y"):
     """A 3-D axes on ``fig`` (at a [left, bottom, width, height] fraction, or a subplot spec) showing the scene
-    box ``box`` with equal scales, labelled in scene axes, seen from bearing ``azim`` [deg]."""
+    box ``box`` (of the run in ropesim's y-up frame) with equal scales, labelled in the scene's own axes (``up``
+    "z": matplotlib's (X, Y, Z) = (x, -z, y) of the y-up frame are the z-up scene's (x, y, z) themselves), seen
+    from bearing ``azim`` [deg]."""
     from matplotlib.ticker import FuncFormatter
 
     if isinstance(rect_or_spec, (list, tuple)):
@@ -99,9 +102,11 @@ def axes_3d(fig, rect_or_spec, box: np.ndarray, follow: bool, fontsize: float = 
     ax.set_box_aspect((spans[0], spans[2], spans[1]), zoom=1.05)
     ax.computed_zorder = False     # drawn in zorder: the seabed under the lines that rest on it
     ax.view_init(elev=ELEVATION, azim=azim)
-    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{-v:g}" if v else "0"))
     delta = "Δ" if follow else ""
-    for axis, name in ((ax.xaxis, "x"), (ax.yaxis, "z"), (ax.zaxis, "y")):
+    names = ("x", "y", "z") if up == "z" else ("x", "z", "y")
+    if up != "z":    # matplotlib's Y is -z
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{-v:g}" if v else "0"))
+    for axis, name in zip((ax.xaxis, ax.yaxis, ax.zaxis), names):
         axis.set_label_text(f"{delta}{name} [m]", fontsize=fontsize)
         axis.labelpad = 0
     ax.tick_params(labelsize=fontsize - 1, pad=0)

@@ -176,6 +176,10 @@ def scene_from_dict(raw: dict, source: str = "<scene>", default_name: str = "sce
         if key in raw:
             top[key] = parse_value(raw[key], sp, key, source, dim=0)
     dim = top.get("dimension", 2)
+    up = top.get("up", "y")
+    if up == "z" and dim != 3:
+        raise SceneError(source, "up", f"a {dim}-D scene is drawn in x and y with y up; up = 'z' is for 3-D "
+                                       f"scenes (dimension = 3)")
     ctx = _Ctx(source, dim)
 
     parts: dict[str, Any] = {"rope": None if is_system else _resolve_rope(ctx.table(raw, "rope", S.Rope), source)}
@@ -207,9 +211,17 @@ def scene_from_dict(raw: dict, source: str = "<scene>", default_name: str = "sce
         name=top.get("name", default_name),
         description=top.get("description", ""),
         dimension=dim,
+        up=up,
         **parts,
     )
     base = Path(base_dir) if base_dir is not None else Path.cwd()
+    if up == "z":
+        from .frame import twin_of
+
+        def fail(key, message):
+            raise SceneError(source, key, message)
+
+        scene = twin_of(scene, base, fail)
     return _check_system(scene, source, base) if is_system else _check_scene(scene, source, base)
 
 
@@ -364,7 +376,8 @@ def _check_seabed(scene: S.Scene, fail) -> None:
         if bed.contact_width is None and bare:
             fail("seabed.contact_width", f"missing: the seabed pushes on a footprint contact_width x node length; "
                                          f"give it, or every line's diameter (lines.{bare[0]} has none)")
-        held = [(f"{p.kind} point '{p.id}' (points.{j}, at y = {p.position[1]:.6g} m)", p.position[0], p.position[1])
+        held = [(f"{p.kind} point '{p.id}' (points.{j}, at {scene.up} = {p.position[1]:.6g} m)", p.position[0],
+                 p.position[1])
                 for j, p in enumerate(scene.points) if p.kind in (*S.STILL_KINDS, "driven")]
     else:
         if bed.contact_width is None and scene.rope.diameter is None:
@@ -374,7 +387,7 @@ def _check_seabed(scene: S.Scene, fail) -> None:
 
         x = initial_positions(scene)   # the held nodes where the scene puts them (the sagging guess keeps its ends)
         nodes = set(scene.pinned.nodes if scene.pinned else ()) | {i for d in scene.driven for i in d.nodes}
-        held = [(f"held node {i} (at y = {x[1][i]:.6g} m)", x[0][i], x[1][i])
+        held = [(f"held node {i} (at {scene.up} = {x[1][i]:.6g} m)", x[0][i], x[1][i])
                 for i in sorted(scene.node(i) for i in nodes)]
     slope = math.radians(bed.slope)
     for what, x, y in held:
@@ -523,8 +536,9 @@ def _check_flow_covers_the_start(scene: S.Scene, fail) -> None:
         y, what, whose = initial_positions(scene)[1], "rope starts", "rope"
     low, high = float(min(y)), float(max(y))
     if low < flow.heights[0] or high > flow.heights[-1]:
-        fail("flow.heights", f"cover y = {flow.heights[0]:g} to {flow.heights[-1]:g} m, but the {what} at "
-                             f"y = {low:g} to {high:g} m; extend the table to the {whose}'s range")
+        up = scene.up    # the twin's y is the height, named as the scene names it
+        fail("flow.heights", f"cover {up} = {flow.heights[0]:g} to {flow.heights[-1]:g} m, but the {what} at "
+                             f"{up} = {low:g} to {high:g} m; extend the table to the {whose}'s range")
 
 
 def _check_name_and_length(scene: S.Scene, fail) -> None:
@@ -634,6 +648,12 @@ def _read_start(scene: S.Scene, base_dir: Path, fail) -> S.Scene:
             fail("initial.time", f"{folder} saved no frame at t = {init.time:g} s; it saved frames from "
                                  f"{t[0]:g} to {t[-1]:g} s{step} (nearest: {t[k]:.6g} s)")
     x, v = np.asarray(xs[k], dtype=float), np.asarray(vs[k], dtype=float)
+    if _up_of_run(folder) != scene.up:
+        fail("initial.run", f"{folder} was run with up = '{_up_of_run(folder)}' and this scene has up = "
+                            f"'{scene.up}'; start from a run in the same frame")
+    from .frame import frame_of
+
+    x, v = frame_of(scene).into(x), frame_of(scene).into(v)     # the run's frames are in its scene's frame
     if not (np.all(np.isfinite(x)) and np.all(np.isfinite(v))):
         fail("initial.time", f"{folder}'s frame at t = {t[k]:g} s is not finite (the run blew up); choose an "
                              f"earlier one")
@@ -641,6 +661,16 @@ def _read_start(scene: S.Scene, base_dir: Path, fail) -> S.Scene:
     start = S.PointsStart(points=tuple(tuple(float(c) for c in row) for row in x),
                           velocity=(0.0,) * dim if init.at_rest else None, velocities=velocities)
     return replace(scene, initial=start)
+
+
+def _up_of_run(folder: Path) -> str:
+    """The ``up`` of the scene a run folder was run with (y when its scene.toml does not say)."""
+    from ..io.runfolder import SCENE
+
+    try:
+        return str(tomllib.loads((folder / SCENE).read_text(encoding="utf-8")).get("up", "y"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return "y"
 
 
 def _resolve_initial(scene: S.Scene, fail) -> S.Scene:

@@ -16,8 +16,9 @@ type, a section ropesim does not know or units MoorDyn would not read as SI are.
 
 Conventions, mapped exactly (``tests/references/MOORDYN_CONVENTIONS.md`` sets them side by side):
 
-- frame: MoorDyn's z points up. The scene keeps MoorDyn's numbers with ``up = "z"`` when ropesim has that key;
-  otherwise a point (x, y, z) becomes ropesim's (x, z, -y), a proper rotation (:func:`to_y_up`);
+- frame: MoorDyn's z points up. The scene keeps MoorDyn's numbers with ``up = "z"`` (the loader turns it into its
+  y-up twin, :mod:`ropesim.scene.frame`, and every output back); with ``y_up`` a point (x, y, z) is written as
+  ropesim's (x, z, -y) instead, a proper rotation (:func:`to_y_up`);
 - a line type's d, mass per metre, EA, BA (a negative BA is a damping ratio: ``axial_damping_ratio``), EI, Cd, Ca,
   CdAx, CaAx are the line type's diameter, mass_per_length, EA, axial_damping, EI, cd_normal, ca_normal,
   cd_tangential, ca_tangential, with MoorDyn's areas (normal drag on d l, tangential on pi d l) and its lumping
@@ -174,9 +175,10 @@ def split_sections(text: str, source: str) -> dict[str, _Section]:
 
 
 def read_moordyn(text: str, source: str = "<moordyn>", base_dir: str | Path | None = None,
-                 y_up: bool = True) -> Translation:
+                 y_up: bool = False) -> Translation:
     """The scene of a MoorDyn v2 input file (see the module's docstring); raises :class:`MoorDynError`.
-    ``y_up``: write the scene in ropesim's y-up frame, (x, y, z) -> (x, z, -y)."""
+    ``y_up``: write the scene in ropesim's y-up frame, (x, y, z) -> (x, z, -y), instead of MoorDyn's own with
+    ``up = "z"`` (the default)."""
     sections = split_sections(text, source)
     if not sections:
         raise MoorDynError(source, None, "not a MoorDyn input file: no line of it opens a MoorDyn section (---- "

@@ -5,7 +5,9 @@ scene is one rope: ``[rope]``, ``[initial]`` and ``[integrator]`` (always), and 
 ``[drag]``, ``[bending]``, ``[thrower]``, ``[[guides]]``, ``[pinned]``, ``[[driven]]``, ``[[overrides]]``,
 ``[output]`` and the fluid and seabed tables; or a system: ``[[lines]]`` between ``[[points]]``, rigid
 ``[[bodies]]``, named ``[line_types.NAME]``, ``[integrator]``, and the same force tables (see "systems"
-below). Units are SI throughout; x is horizontal and y points up (z is the third axis in 3-D).
+below). Units are SI throughout; x is horizontal and y points up (z is the third axis in 3-D), unless a 3-D
+scene says ``up = "z"`` (MoorDyn's and OrcaFlex's frame; :mod:`ropesim.scene.frame`): then z points up, and what
+this schema says of y (heights, the seabed's plane, gravity along -y) is said of z.
 
 The dataclasses below are the schema: every field's ``metadata`` holds a :class:`Spec` saying what the TOML
 value may be. :mod:`ropesim.loader` reads a file against them; :func:`scene_to_dict` writes a scene back with
@@ -754,6 +756,10 @@ class Scene:
     integrator: Integrator
     output: Output = Output()
     description: str = ""
+    up: str = "y"
+    given_orientations: tuple = field(default=(), compare=False, repr=False)
+    """A z-up scene's rigid bodies' orientations as its file gave them (the bodies hold their y-up twins'), written
+    back as they were (:mod:`ropesim.scene.frame`)."""
     gravity: Gravity | None = None
     drag: Drag | None = None
     fluid: Fluid | None = None
@@ -791,6 +797,9 @@ TOP_LEVEL_SCALARS = {
                  "font draws (CJK without fonts-noto-cjk) shows as its code point in picture titles", required=False),
     "description": Spec("str", "one line saying what the scene shows", required=False),
     "dimension": Spec("int", "2 or 3 spatial dimensions", required=False, choices=(2, 3)),
+    "up": Spec("str", "the axis that points up, against gravity (3-D): y (ropesim's frame, the default) or z "
+               "(MoorDyn's and OrcaFlex's); every key and output is in the scene's own frame", required=False,
+               choices=("y", "z")),
 }
 TABLES = {
     "rope": Rope,
@@ -828,8 +837,13 @@ SYSTEM_ONLY_TABLES = ("points", "line_types")
 
 
 def scene_to_dict(scene: Scene) -> dict:
-    """The scene as a TOML-ready dict, every default filled in; undeclared parts stay absent."""
+    """The scene as a TOML-ready dict, every default filled in; undeclared parts stay absent; in the scene's own
+    frame (a z-up scene's keys as its file gives them, not its y-up twin's)."""
     from dataclasses import fields
+
+    from .frame import scene_out
+
+    scene = scene_out(scene)
 
     def table(obj) -> dict:
         out = {}
@@ -850,6 +864,7 @@ def scene_to_dict(scene: Scene) -> dict:
     if scene.description:
         out["description"] = scene.description
     out["dimension"] = scene.dimension
+    out["up"] = scene.up
     for key in TABLES:
         part = getattr(scene, key)
         if part is not None:

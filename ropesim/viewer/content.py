@@ -152,6 +152,7 @@ class RunContent:
     summary: list[tuple[str, str]] = field(default_factory=list)
     description: str = ""
     where: str = ""                              # the run folder, or "in memory"
+    axes: tuple = ("x", "y", "z")                # the scene's names of the drawn axes (a z-up scene's: x, z, -y)
 
     @property
     def frames(self) -> int:
@@ -199,6 +200,7 @@ def run_content(run) -> RunContent:
     from ..model.build import build
 
     traj = run if isinstance(run, Trajectory) else Trajectory.open(Path(run))
+    traj = traj.internal    # drawn in the y-up frame the model's geometry is in (the viewer's y is up)
     scene = traj.scene
     model = build(scene, solve=False)    # node masses and the marks; the frames hold the shape
     fields = []
@@ -208,6 +210,7 @@ def run_content(run) -> RunContent:
         fields.append(Field("strain", "%", "segment", Scaled(traj.strain, 100.0)))
     fields.append(Field("speed", "m/s", "node", Speed(traj.v)))
     content = RunContent(name=scene.name, dimension=scene.dimension, t=np.asarray(traj.t, dtype=float),
+                         axes=("x", "z", "-y") if scene.up == "z" else ("x", "y", "z"),
                          description=scene.description,
                          where=str(traj.folder) if traj.folder is not None else "in memory")
     if scene.is_system:

@@ -337,7 +337,7 @@ def _pack_run(content: RunContent, frames: np.ndarray, extent: Extent, buffer: B
         bodies.append(entry)
     return {
         "name": content.name, "description": content.description, "where": content.where, "color": color,
-        "dimension": d, "frames": len(frames), "saved_frames": content.frames,
+        "dimension": d, "axes": list(content.axes), "frames": len(frames), "saved_frames": content.frames,
         "time": buffer.add(np.asarray(content.t[frames], dtype=np.float64)),
         "quantisation": {"origin": extent.origin.tolist(), "step": extent.step, "bound": extent.bound,
                          "size": extent.size},

@@ -654,7 +654,7 @@ positions(run, line), bodyPose(run, body), and the promise `ready` (the first fr
         const g = canvas.getContext("2d");
         g.font = "bold 44px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
         g.fillStyle = "#" + colors[c].toString(16).padStart(6, "0");
-        g.fillText("xyz"[c], 32, 34);
+        g.fillText((this.runs[0].axes || ["x", "y", "z"])[c], 32, 34);
         const texture = new THREE.CanvasTexture(canvas);
         const label = new THREE.Sprite(new THREE.SpriteMaterial({ map: texture, depthTest: false }));
         label.position.copy(dir).multiplyScalar(1.35);
