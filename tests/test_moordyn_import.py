@@ -2,7 +2,7 @@
 
 Every file of MoorDyn's ``tests/Mooring/`` is listed with what ropesim does with it: imports and runs, or refuses
 in one line (its input files are copied in ``tests/data/moordyn/mooring/``; the data files they read are named but
-not copied, but two). lines.txt (OC3-Hywind) gives MoorDyn's statics, stored by
+not copied, but three). lines.txt (OC3-Hywind) gives MoorDyn's statics, stored by
 ``tests/references/moordyn_lines_statics.py``. Bad input is one line naming the file, the line number and what is
 wrong, exit 2.
 """
@@ -65,7 +65,7 @@ MOORDYN_TESTS_MOORING = {
                                        "vortex-induced vibration"),
     "lifting.txt": RUNS,
     "lines.txt": RUNS,
-    "lines.txt.ic": DATA_FILE,
+    "lines.txt.ic": (None, NOT_INPUT),   # MoorDyn's stored state (binary), copied for its own run of lines.txt
     "local_euler/complex_system.txt": (14, ROD),
     "local_euler/duplicated.txt": RUNS,
     "local_euler/hanging.txt": RUNS,
