@@ -113,9 +113,9 @@ class System:
         return i.x, i.v
 
     def node_forces(self) -> np.ndarray:
-        """Every node's net force now (D, N) [N], m acc (the coupling's last evaluation, at the step's end)."""
+        """Every node's net force (D, N) [N], m acc, of the evaluation the coupling's last forces came from."""
         self.state()
-        return self.model.mass * self.coupling._acc
+        return self.model.mass * self.coupling.node_accelerations()
 
 
 def moordyn_rotation(roll: float, pitch: float, yaw: float) -> np.ndarray:
