@@ -5,7 +5,8 @@ wave-energy model), as MoorDyn's coupled points and bodies are. At every couplin
 coupled object's position and velocity at the step's start, time t; ropesim moves it on the straight line
 x(t + tau) = x + V tau for the whole step (MoorDyn's rule, ``Body::updateFairlead``), takes its own internal
 steps of the scene's integrator inside the step, and returns the forces and moments on the coupled objects at
-the step's end. A coupled body moves its points rigidly, as a driven body does (:mod:`ropesim.model.motion`):
+the step's end: from the integrator's last force evaluation when it is at the step's end time (rk4's last stage,
+as MoorDyn reports its last evaluation's), from an evaluation at the end state otherwise. A coupled body moves its points rigidly, as a driven body does (:mod:`ropesim.model.motion`):
 its pose is its reference point and its angles about x, then y, then z (R = Rz Ry Rx), and the caller gives the
 angles' rates with its velocity.
 
@@ -141,9 +142,12 @@ class Coupling:
         self.integrator = None
         self.writer = None
         self._rows = None
-        self._begin_step = self._end = self._no_frames = None
+        self._begin_step = self._end = self._held = self._no_frames = None
         self._objects = objects_bundle(self.objects, self.model.dim)
         self._acc = np.zeros((self.model.dim, self.model.nodes))
+        self._last_acc = self._acc       # the accelerations the last forces came from
+        self._loop_acc = None            # the loop's last evaluation, when it is at the step's end time
+        self._step_dt = self._step_n = None
         self.wall_time = 0.0
 
     # -- what the caller asks ------------------------------------------------------------------------------
@@ -198,16 +202,22 @@ class Coupling:
         if self.integrator is None:
             raise CouplingError(f"{self.scene.name}: step() before init(); call init() first (it solves the "
                                 f"static shape and starts the clock at t = 0)")
-        if not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt) and dt > 0):
-            raise CouplingError(f"{self.scene.name}: step: dt = {dt!r}; give a positive, finite coupling step [s]")
-        if not (isinstance(t, (int, float, np.floating)) and math.isfinite(t)) or abs(t - self.t) > 1e-9 * max(
-                abs(self.t), dt):
-            raise CouplingError(f"{self.scene.name}: step: t = {t!r} s, but the coupling stands at t = {self.t!r} s; "
+        if dt != self._step_dt:     # a coupling step checked once, with its number of internal steps, until it changes
+            if not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt) and dt > 0):
+                raise CouplingError(f"{self.scene.name}: step: dt = {dt!r}; give a positive, finite coupling step [s]")
+            self._step_n = self._internal_steps(float(dt))
+            self._step_dt = dt
+        i = self.integrator
+        now = i.step * i.grid.dt
+        try:
+            on_time = abs(t - now) <= 1e-9 * max(abs(now), dt)     # False for a NaN
+        except TypeError:
+            on_time = False
+        if not on_time:
+            raise CouplingError(f"{self.scene.name}: step: t = {t!r} s, but the coupling stands at t = {now!r} s; "
                                 f"each step starts where the last one ended (the first at t = 0)")
-        x = self._checked(positions, "positions")
-        v = self._checked(velocities, "velocities")
-        n = self._internal_steps(float(dt))
-        return self._advance(n, x, v)
+        return self._advance(self._step_n, self._checked(positions, "positions"),
+                             self._checked(velocities, "velocities"))
 
     def mass(self) -> np.ndarray:
         """The mass matrix (dofs, dofs) [kg, kg m, kg m^2] of what the coupled objects carry now: their line ends'
@@ -334,18 +344,17 @@ class Coupling:
     # -- inside --------------------------------------------------------------------------------------------
 
     def _checked(self, values, what: str) -> np.ndarray:
+        """``values`` as a fresh C-ordered float64 array (the compiled calls take no other; copying a few numbers
+        costs less than asking an array whether it is one), of the right shape; :meth:`_begin` checks that every
+        value is finite."""
         try:
-            a = np.array(values, dtype=np.float64)   # a fresh C-ordered copy: the compiled calls take no other
+            a = np.array(values, dtype=np.float64)
         except (TypeError, ValueError):
             raise CouplingError(f"{self.scene.name}: {what}: not an array of numbers ({type(values).__name__}); "
                                 f"give {self.dofs} numbers ({self.layout()})") from None
         if a.shape != (self.dofs,):
             raise CouplingError(f"{self.scene.name}: {what}: {a.size} numbers of shape {a.shape}; the coupled "
                                 f"objects have {self.dofs} degrees of freedom ({self.layout()})")
-        if not np.isfinite(a).all():
-            k = int(np.flatnonzero(~np.isfinite(a))[0])
-            raise CouplingError(f"{self.scene.name}: {what}[{k}] = {float(a[k])!r} ({self._dof_name(k)}); every value "
-                                f"must be a finite number")
         return a
 
     def layout(self) -> str:
@@ -384,7 +393,11 @@ class Coupling:
             from .model.coupled import begin_step
 
             self._begin_step = Direct(self.model.kernel(begin_step))
-        self._begin_step(float(t0), x, v, self._objects, held, state_x, state_v)
+        bad = self._begin_step.fast(float(t0), x, v, self._objects, held, state_x, state_v)
+        if bad >= 0:     # nothing was moved
+            what, a, k = ("positions", x, bad) if bad < self.dofs else ("velocities", v, bad - self.dofs)
+            raise CouplingError(f"{self.scene.name}: {what}[{k}] = {float(a[k])!r} ({self._dof_name(k)}); every value "
+                                f"must be a finite number")
 
     def _solve_statics(self) -> None:
         from .model.build import EquilibriumError
@@ -414,6 +427,11 @@ class Coupling:
         self._no_frames = None
         self.integrator.warm_up()
         self.integrator.loop = Direct(self.integrator.loop)   # its arguments keep their types: no dispatch
+        self._loop_acc = self.integrator.last_accelerations
+        held = self.integrator.held       # what held_forces reads of it: the held nodes, a body's pose and rates
+        m = held.motion
+        self._held_args = (held.idx, *((m.bodies.accel, m.bodies.base) if m.bodies is not None else (m.base, m.base)))
+        self._step_dt = None             # the coupling step is checked again against the new internal step
         if self.folder is not None and self.writer is None:
             from .io.runfolder import RunWriter
             from .run import _manifest_info
@@ -444,7 +462,7 @@ class Coupling:
     def _advance(self, n: int, x: np.ndarray, v: np.ndarray) -> np.ndarray:
         i = self.integrator
         tick = time.perf_counter()
-        self._begin(i.t, x, v, i.held, i.x, i.v)
+        self._begin(i.step * i.grid.dt, x, v, i.held, i.x, i.v)
         if i.frames_in(n):
             frames = i.new_frames(n)
         else:                               # most coupling steps save no frame: the same empty buffers
@@ -452,6 +470,8 @@ class Coupling:
                 self._no_frames = i.new_frames(0)
             frames = self._no_frames
         done, written, status, node = i._run(n, frames)     # Integrator.advance, without its bundling
+        if type(i.loop) is Direct:          # after its first call the loop is its compiled copy itself
+            i.loop = i.loop.fast
         i.step += done
         if self.writer is not None and written:
             self.writer.append(self._rows(frames.t[:written], frames.x[:written], frames.v[:written],
@@ -461,13 +481,16 @@ class Coupling:
 
             _, message = _blow_up_message(self.model, i, status, node)
             raise CouplingError(f"{self.scene.name}: {message}")
-        forces = self._end_forces()
+        if self._loop_acc is None:
+            forces = self._end_forces()
+        else:
+            forces = self._loop_forces()
         self.wall_time += time.perf_counter() - tick
         return forces
 
     def _end_forces(self) -> np.ndarray:
-        """The forces and moments on the coupled objects now (see the module doc;
-        :func:`ropesim.model.coupled.end_forces`)."""
+        """The forces and moments on the coupled objects now, from an evaluation at the state now (see the module
+        doc; :func:`ropesim.model.coupled.end_forces`)."""
         model, i = self.model, self.integrator
         if self._end is None:
             from .model.coupled import end_forces
@@ -475,7 +498,27 @@ class Coupling:
             self._end = Direct(model.kernel(end_forces))
         out = np.zeros(self.dofs)
         self._end(i.x, i.v, self._acc, model.params, float(i.t), model.mass, self._objects, i.held, out)
+        self._last_acc = self._acc
         return out
+
+    def _loop_forces(self) -> np.ndarray:
+        """The forces and moments on the coupled objects at the end of the loop's last step, from its last force
+        evaluation (:attr:`ropesim.integrate.base.Integrator.last_accelerations`;
+        :func:`ropesim.model.coupled.held_forces`)."""
+        i = self.integrator
+        if self._held is None:
+            from .model.coupled import held_forces
+
+            self._held = Direct(self.model.kernel(held_forces))
+        out = np.zeros(self.dofs)
+        self._held.fast(i.x, self._loop_acc, i.step * i.grid.dt, self.model.mass, self._objects, *self._held_args,
+                        out)
+        self._last_acc = self._loop_acc
+        return out
+
+    def node_accelerations(self) -> np.ndarray:
+        """The accelerations (D, N) of the evaluation the last forces came from (m a is each node's net force)."""
+        return self._last_acc
 
     def _finish(self) -> None:
         from .analysis.ledger import ledger_arrays

@@ -2,7 +2,7 @@
 
 Every file of MoorDyn's ``tests/Mooring/`` is listed with what ropesim does with it: imports and runs, or refuses
 in one line (its input files are copied in ``tests/data/moordyn/mooring/``; the data files they read are named but
-not copied, but two). lines.txt (OC3-Hywind) gives MoorDyn's statics, stored by
+not copied, but three). lines.txt (OC3-Hywind) gives MoorDyn's statics, stored by
 ``tests/references/moordyn_lines_statics.py``. Bad input is one line naming the file, the line number and what is
 wrong, exit 2.
 """
@@ -26,7 +26,8 @@ MOORING = DATA / "mooring"
 RUNS, DATA_FILE = "imports and runs", "a data file another input reads (not copied)"
 ROD = "uses rods (ROD TYPES): ropesim has no rods yet"
 WAVES = "uses wave kinematics (WaveKin): ropesim has no waves yet"
-CURRENTS = "uses currents from a file (Currents): give a steady current as [flow] by hand"
+CURRENTS = ("uses currents that vary in time or across the sea (Currents = {}): ropesim's [flow] is steady and varies "
+            "with height only (Currents = 1 is read)")
 NOT_INPUT = "not a MoorDyn input file: no line of it opens a MoorDyn section (---- LINE TYPES ----, ---- LINES ----, ...)"
 
 # Every file in MoorDyn's tests/Mooring/ (commit 319ff99), and what `ropesim import moordyn` does with it: RUNS, or
@@ -65,7 +66,7 @@ MOORDYN_TESTS_MOORING = {
                                        "vortex-induced vibration"),
     "lifting.txt": RUNS,
     "lines.txt": RUNS,
-    "lines.txt.ic": DATA_FILE,
+    "lines.txt.ic": (None, NOT_INPUT),   # MoorDyn's stored state (binary), copied for its own run of lines.txt
     "local_euler/complex_system.txt": (14, ROD),
     "local_euler/duplicated.txt": RUNS,
     "local_euler/hanging.txt": RUNS,
@@ -95,7 +96,7 @@ MOORDYN_TESTS_MOORING = {
     "time_schemes.txt": (19, "option dtM must be a number, got '@DT@'"),   # a template MoorDyn's test fills in
     "tripod.txt": RUNS,
     "viv/current_profile.txt": (None, NOT_INPUT),
-    "viv/viv.txt": (32, CURRENTS),
+    "viv/viv.txt": (6, "line type 'cable' has a lift coefficient Cl (VIV): ropesim has no vortex-induced vibration"),
     "wave_surface/wave_frequencies.txt": DATA_FILE,
     "wave_surface/wave_surface.txt": (40, WAVES),
     "wavekin_2/current_profile.txt": DATA_FILE,
@@ -108,9 +109,9 @@ MOORDYN_TESTS_MOORING = {
     **{f"wavekin_2/{name}.txt": (28, WAVES) for name in ("wavekin_2", "wavekin_2_curr2", "wavekin_2_curr5",
                                                           "wavekin_3", "wavekin_3_curr2", "wavekin_3_curr5")},
     "wavekin_3/current_profile_dynamic.txt": DATA_FILE,
-    "wavekin_3/test_dynamic_currents.txt": (31, CURRENTS),
+    "wavekin_3/test_dynamic_currents.txt": (31, CURRENTS.format(2)),
     "wavekin_4/current_profile_4d.txt": DATA_FILE,
-    "wavekin_4/hanging_lines.txt": (54, CURRENTS),
+    "wavekin_4/hanging_lines.txt": (54, CURRENTS.format(5)),
     "wavekin_4/make_4d_currents.py": DATA_FILE,
     "wavekin_4/water_grid.txt": DATA_FILE,
     "wavekin_7/water_grid.txt": DATA_FILE,
@@ -132,14 +133,15 @@ def test_every_copied_file_is_listed_and_every_listed_input_is_copied():
 def test_each_file_imports_or_is_refused_in_its_one_line(name):
     expected = MOORDYN_TESTS_MOORING[name]
     text = (MOORING / name).read_text(errors="replace")
+    folder = (MOORING / name).parent      # where MoorDyn reads the files an input names (current_profile.txt)
     if expected == RUNS:
-        translation = read_moordyn(text, name)
+        translation = read_moordyn(text, name, folder)
         scene = scene_from_toml(scene_text(translation, name, "imported"))
         assert scene.is_system and scene.lines and scene.dimension == 3
         return
     line, message = expected
     with pytest.raises(SceneError) as exc:
-        read_moordyn(text, name)
+        read_moordyn(text, name, folder)
     assert str(exc.value) == f"{name}: {f'line {line}: ' if line else ''}{message}"
 
 
@@ -292,3 +294,39 @@ def test_bad_input_is_one_line_naming_the_file_and_line_exit_2(case, tmp_path):
         [said] = done.stderr.strip().splitlines()
         assert said.startswith(f"ropesim: {path}: line {line}: {message}")
         assert "Traceback" not in done.stderr and not (tmp_path / "bad.toml").exists()
+
+
+PROFILE = """--------------------- MoorDyn steady currents File ----------------------------------
+Tabulated file with the water currents components
+z (m), ux (m/s), uy (m/s), uz (m/s)
+-320.0 0.1 0.0 0.0
+-160.0 0.3 -0.2
+0.0 0.6 -0.4 0.05
+"""
+
+
+def test_a_steady_current_profile_becomes_flows_table_with_the_files_values(tmp_path):
+    """MoorDyn's Currents = 1 reads current_profile.txt beside the input (z, ux [, uy [, uz]], three header lines;
+    a missing component is 0) and interpolates it linearly in z, held beyond its end rows: [flow]'s table, heights
+    the file's z (ropesim's y is MoorDyn's z), velocities turned (ux, uy, uz) -> (ux, uz, -uy). The drag then sees
+    it: a node 240 m down feels the current interpolated there."""
+    text = (MOORING / "lines.txt").read_text().replace("1       disableOutTime", "1       disableOutTime\n1 Currents")
+    (tmp_path / "lines.txt").write_text(text)
+    (tmp_path / "current_profile.txt").write_text(PROFILE)
+    scene = load_scene(tmp_path / "lines.txt")
+    assert scene.flow.profile == "table" and scene.flow.heights == (-320.0, -160.0, 0.0)
+    assert np.array_equal(scene.flow.velocities, [[0.1, 0.0, -0.0], [0.3, 0.0, 0.2], [0.6, 0.05, 0.4]])
+    from ropesim.model.forces.fluid import _flow, flow_at
+
+    scalars, table = _flow(scene, None)
+    assert np.allclose(flow_at(-240.0, 1e9, scalars, table), [0.2, 0.0, 0.1], rtol=1e-15)   # halfway, turned
+    assert np.allclose(flow_at(-400.0, 1e9, scalars, table), [0.1, 0.0, 0.0], rtol=1e-15)   # held below
+    written = scene_text(read_moordyn(text, "lines.txt", tmp_path), "lines.txt", "lines")
+    assert "MoorDyn's Currents = 1: the steady current profile of current_profile.txt (3 depths)" in " ".join(
+        written.replace("#", " ").split())
+    (tmp_path / "current_profile.txt").unlink()
+    done = _cli("run", str(tmp_path / "lines.txt"))
+    assert done.returncode == 2
+    [said] = done.stderr.strip().splitlines()
+    assert said.startswith(f"ropesim: {tmp_path / 'lines.txt'}: line 35: Currents = 1 reads "
+                           f"{tmp_path / 'current_profile.txt'}, which cannot be read"), said

@@ -193,7 +193,7 @@ def _say_what_moordyn_loses(path: Path) -> None:
 
     text = path.read_text(encoding="utf-8", errors="replace")
     if looks_like_moordyn(text):
-        for note in read_moordyn(text, str(path)).notes:
+        for note in read_moordyn(text, str(path), path.resolve().parent).notes:
             typer.echo(f"ropesim: {path}: not translated: {note}", err=True)
 
 
@@ -607,7 +607,7 @@ def import_(
     target = out if out is not None else Path(f"{file.stem}.toml")
     name = target.stem
     try:
-        translation = read_moordyn(text, label)
+        translation = read_moordyn(text, label, file.resolve().parent)
         scene_from_dict({"name": name, **translation.scene}, source=f"{label} (imported)",
                         base_dir=file.resolve().parent)
     except SceneError as exc:

@@ -10,7 +10,7 @@ ropesim by changing its import::
     moordyn.Close(system)
 
 Every array is in MoorDyn's frame and units: z up, SI, angles in radians. The scene is read by
-:func:`ropesim.load_scene` (a ropesim scene, or a MoorDyn input file once ropesim reads them); its coupled
+:func:`ropesim.load_scene`: a ropesim scene, or a MoorDyn v2 input file as ``ropesim run`` reads it; its coupled
 points and bodies (``kind = "coupled"``, MoorDyn's Coupled and Vessel objects) are the coupled degrees of
 freedom, bodies first, then points, each in the scene's order, as MoorDyn orders them. A y-up scene's
 coordinates are turned: MoorDyn's (x, y, z) is the scene's (x, z, -y). Calls run through
@@ -113,9 +113,9 @@ class System:
         return i.x, i.v
 
     def node_forces(self) -> np.ndarray:
-        """Every node's net force now (D, N) [N], m acc (the coupling's last evaluation, at the step's end)."""
+        """Every node's net force (D, N) [N], m acc, of the evaluation the coupling's last forces came from."""
         self.state()
-        return self.model.mass * self.coupling._acc
+        return self.model.mass * self.coupling.node_accelerations()
 
 
 def moordyn_rotation(roll: float, pitch: float, yaw: float) -> np.ndarray:
@@ -156,7 +156,8 @@ class Handle:
 
 
 def Create(filepath: str = "") -> System:
-    """The system of scene file ``filepath`` (a ropesim scene; MoorDyn's default "Mooring/lines.txt" if empty)."""
+    """The system of scene file ``filepath``: a ropesim scene or a MoorDyn v2 input file (MoorDyn's default
+    "Mooring/lines.txt" if empty)."""
     from ..scene.loader import load_scene
 
     return System(load_scene(filepath or str(Path("Mooring") / "lines.txt")))

@@ -239,6 +239,14 @@ class Integrator:
     # -- shared ----------------------------------------------------------------------------------------------
 
     @property
+    def last_accelerations(self) -> np.ndarray | None:
+        """The accelerations (D, N) of the loop's last force evaluation, when the family's last evaluation of a step
+        is at the step's end time with every held node where its motion puts it then, so that its held columns are
+        the held nodes' net force per unit mass at the end of the last step (:mod:`ropesim.coupling` reports
+        them); None when it is not."""
+        return None
+
+    @property
     def t(self) -> float:
         return self.step * self.grid.dt
 

@@ -112,6 +112,12 @@ class RungeKuttaFamily(Integrator):
     def force_evaluations(self) -> int:
         return self.step * self.method.evaluations
 
+    @property
+    def last_accelerations(self) -> np.ndarray | None:
+        # a last stage at c = 1 (rk4) is at the step's end time t + h, its held nodes placed there; its free nodes
+        # at y + h sum_j a_sj K_j, which differs from the end state by O(h^2) (rk4: y + h K_3)
+        return self.scratch.acc if self.method.c[-1] == 1.0 else None
+
     def _run(self, n, frames):
         m = self.model
         return self.loop((self.x, self.v, self.ledger), self.tables, self.scratch, self.held, m.mass, self.gamma,

@@ -1,8 +1,10 @@
 """The compiled ends of a coupling step (:mod:`ropesim.coupling`): moving the coupled objects, and their forces.
 
-A coupling step is one call of :func:`begin_step`, the integrator's loop, and one call of :func:`end_forces`,
-each entered without Numba's type dispatch (:class:`ropesim.model.jit.Direct`), so that a coupling step of one
-internal step costs little more than the step.
+A coupling step is one call of :func:`begin_step`, the integrator's loop, and one call of :func:`held_forces`
+(on the accelerations of the loop's last force evaluation, when its method's last one is at the step's end time)
+or of :func:`end_forces` (which evaluates them at the end state first), each entered without Numba's type
+dispatch (:class:`ropesim.model.jit.Direct`), so that a coupling step of one internal step costs little more than
+the step.
 
 The coupled objects, K of them, in the layout of the coupling's arrays (``Objects``): ``kind`` (K,) 0 for a
 point, 1 for a body; ``first`` (K,) its first degree of freedom; ``body`` (K,) a body's column among the bodies
@@ -14,6 +16,8 @@ degrees of freedom among a driven body's six rows ((0, 1, 2, 3, 4, 5) in 3-D, (0
 from __future__ import annotations
 
 from collections import namedtuple
+
+import numpy as np
 
 from . import jit
 from .motion import WITH_RIGID_MOTION, place_moving
@@ -28,7 +32,15 @@ POINT, BODY = 0, 1
 def begin_step(t0, positions, velocities, objects, held, x, v):
     """Move every coupled object on positions + velocities (t - t0) from time t0 [s] (a point's line ends
     through the held nodes' x0 + V t, a body through its rigid motion's pose at t = 0 and rates), then put every
-    held node where its motion puts it at t0 (velocities too)."""
+    held node where its motion puts it at t0 (velocities too). Returns -1, or, moving nothing, the first value
+    that is not a finite number: k for positions[k], K + k for velocities[k] (K values each)."""
+    count = positions.shape[0]
+    for k in range(count):
+        if not np.isfinite(positions[k]):
+            return k
+    for k in range(count):
+        if not np.isfinite(velocities[k]):
+            return count + k
     idx, x0, hv, m = held
     dim = x.shape[0]
     for k in range(objects.kind.shape[0]):
@@ -54,15 +66,28 @@ def begin_step(t0, positions, velocities, objects, held, x, v):
             for d in range(dim):
                 x[d, i] = x0[d, j] + hv[d, j] * t0
                 v[d, i] = hv[d, j]
+    return -1
 
 
 @jit.kernel
 def end_forces(x, v, acc, params, t, mass, objects, held, out):
-    """Write into ``out`` the force on each coupled point, and the force and moment about its reference point
-    on each coupled body, at time t: the net force m acc of every term on their held nodes, without their
-    inertia (a system's nodes have no linear [drag])."""
+    """:func:`held_forces` of the accelerations at state (x, v) and time t, evaluated into ``acc``."""
     accelerations(x, v, acc, params, t)
-    idx, _, _, m = held
+    m = held.motion
+    if WITH_RIGID_MOTION:
+        held_forces(x, acc, t, mass, objects, held.idx, m.bodies.accel, m.bodies.base, out)
+    else:
+        held_forces(x, acc, t, mass, objects, held.idx, m.base, m.base, out)
+
+
+@jit.kernel
+def held_forces(x, acc, t, mass, objects, idx, pose0, rates, out):
+    """Write into ``out`` the force on each coupled point, and the force and moment about its reference point
+    on each coupled body, at time t: the net force m acc of every term on their held nodes ``idx`` (accelerations
+    ``acc`` of an evaluation at time t, held nodes at x), without their inertia (a system's nodes have no linear
+    [drag]). A body's reference point is at pose0 + rates t (the rigid motion's first three rows; unread without
+    rigid motion). It takes these arrays rather than the held nodes' bundle: a compiled call unpacks every array it
+    is handed, and the bundle holds some twenty."""
     dim = x.shape[0]
     for k in range(objects.kind.shape[0]):
         f = objects.first[k]
@@ -70,10 +95,10 @@ def end_forces(x, v, acc, params, t, mass, objects, held, out):
         rx = ry = rz = 0.0
         if WITH_RIGID_MOTION and objects.kind[k] == BODY:
             b = objects.body[k]
-            rx = m.bodies.accel[0, b] + m.bodies.base[0, b] * t
-            ry = m.bodies.accel[1, b] + m.bodies.base[1, b] * t
+            rx = pose0[0, b] + rates[0, b] * t
+            ry = pose0[1, b] + rates[1, b] * t
             if dim == 3:
-                rz = m.bodies.accel[2, b] + m.bodies.base[2, b] * t
+                rz = pose0[2, b] + rates[2, b] * t
         for r in range(objects.row_start[k], objects.row_start[k + 1]):
             i = idx[objects.held_rows[r]]
             gx = mass[i] * acc[0, i]

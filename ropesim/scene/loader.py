@@ -62,7 +62,7 @@ def scene_from_moordyn(text: str, source: str = "<moordyn>", default_name: str =
     ``read_moordyn(text).notes``), with ``--set`` style overrides applied; raises :class:`SceneError`."""
     from .moordyn import read_moordyn
 
-    raw = {"name": default_name, **read_moordyn(text, source).scene}
+    raw = {"name": default_name, **read_moordyn(text, source, base_dir).scene}
     for item in overrides:
         apply_override(raw, item, source)
     label = f"{source} (imported from MoorDyn{', with --set ' + ' '.join(overrides) if overrides else ''})"

@@ -9,8 +9,9 @@ the names say, and so does this reader (``source/MoorDyn2.cpp``).
 :func:`read_moordyn` turns the text into a :class:`Translation`: the scene as a TOML-ready dict, the comments that
 go with its keys (where ropesim's law differs from MoorDyn's, it says so) and the ``notes``: one line for each
 thing MoorDyn's file asks for that the scene does not carry (output channels, logging, the IC solver's settings),
-never dropped silently. What would change the physics if left out (rods, wave kinematics, currents, VIV, a
-nonlinear or viscoelastic line, a seabed file, line failure) is refused: :class:`MoorDynError`, one line naming
+never dropped silently. A steady current profile (``Currents = 1``: ``current_profile.txt`` beside the input file)
+becomes ``[flow]``'s table. What would change the physics if left out (rods, wave kinematics, time-varying
+currents, VIV, a nonlinear or viscoelastic line, a seabed file, line failure) is refused: :class:`MoorDynError`, one line naming
 the file, the line number and what is wrong, as a malformed row, a line end on a missing point, a missing line
 type, a section ropesim does not know or units MoorDyn would not read as SI are.
 
@@ -194,7 +195,7 @@ def read_moordyn(text: str, source: str = "<moordyn>", base_dir: str | Path | No
     for key in UNIT_COLUMNS:
         if key in sections:
             _check_units(sections[key], source)
-    translation = _Translator(sections, source, y_up).translate()
+    translation = _Translator(sections, source, y_up, base_dir).translate()
     _fit_time_step(translation, source)
     return translation
 
@@ -273,8 +274,9 @@ def _word_and_number(cell: str) -> tuple[str, str]:
 
 
 class _Translator:
-    def __init__(self, sections: dict[str, _Section], source: str, y_up: bool):
+    def __init__(self, sections: dict[str, _Section], source: str, y_up: bool, base_dir: str | Path | None = None):
         self.sections, self.source, self.y_up = sections, source, y_up
+        self.base_dir = None if base_dir is None else Path(base_dir)
         self.scene: dict = {}
         self.comments: dict[str, str] = {}
         self.notes: list[str] = []
@@ -328,6 +330,7 @@ class _Translator:
         if not self.y_up:
             self.scene["up"] = "z"
         self._environment()
+        self._currents()
         self._line_types()
         self._bodies()
         self._points()
@@ -339,12 +342,57 @@ class _Translator:
 
     def _refuse_options(self) -> None:
         for name, why in (("wavekin", "wave kinematics (WaveKin): ropesim has no waves yet"),
-                          ("currents", "currents from a file (Currents): give a steady current as [flow] by hand")):
-            if name in self.options and self.options[name][0] not in ("0", "0.0"):
-                self.fail(self.options[name][1], f"uses {why}")
+                          ("currents", "currents that vary in time or across the sea (Currents = {}): ropesim's "
+                                       "[flow] is steady and varies with height only (Currents = 1 is read)")):
+            value = self.options.get(name, ("0", None))[0]
+            if value in ("0", "0.0") or (name == "currents" and value in ("1", "1.0")):
+                continue
+            self.fail(self.options[name][1], f"uses {why.format(value)}")
         if "seafloorfile" in self.options:
             self.fail(self.options["seafloorfile"][1], "uses a 3-D seafloor (SeafloorFile): ropesim's seabed is a "
                                                        "plane")
+
+    def _currents(self) -> None:
+        """MoorDyn's Currents = 1: a steady current profile read from current_profile.txt beside the input file
+        (WaveGrid.cpp's constructSteadyCurrentGrid: three header lines, then rows z, ux [, uy [, uz]], missing
+        components 0), interpolated linearly in z and held at the end rows beyond them, as [flow]'s table is."""
+        value, row = self.options.get("currents", ("0", None))
+        if value not in ("1", "1.0"):
+            return
+        if self.base_dir is None:
+            self.fail(row, "Currents = 1 reads current_profile.txt beside the input file, but this file's folder is "
+                           "not known; import it from its file")
+        path = self.base_dir / "current_profile.txt"
+        try:
+            lines = path.read_text(errors="replace").splitlines()
+        except OSError as exc:
+            self.fail(row, f"Currents = 1 reads {path}, which cannot be read ({exc.strerror or exc})")
+        rows = []
+        for number, line in enumerate(lines[3:], start=4):
+            cells = line.replace(",", " ").split()
+            if not cells:
+                continue
+            try:
+                numbers = [float(c) for c in cells[:4]]
+            except ValueError:
+                numbers = []
+            if len(numbers) < 2:
+                raise MoorDynError(str(path), number, "a current profile row is z, ux [, uy [, uz]] in numbers, got "
+                                                      f"{line.strip()!r}")
+            rows.append((numbers + [0.0, 0.0])[:4])
+        if not rows:
+            raise MoorDynError(str(path), None, "no rows of z, ux [, uy [, uz]] after its three header lines")
+        rows.sort(key=lambda r: r[0])
+        heights = [r[0] for r in rows]
+        if len(set(heights)) != len(heights):
+            raise MoorDynError(str(path), None, "two rows at the same depth z")
+        velocities = [self.vector(r[1:]) for r in rows]
+        if len(rows) == 1:
+            self.scene["flow"] = {"velocity": velocities[0]}
+        else:
+            self.scene["flow"] = {"profile": "table", "heights": heights, "velocities": velocities}
+        self.comments["flow"] = (f"MoorDyn's Currents = 1: the steady current profile of {path.name} ({len(rows)} "
+                                 f"depths), interpolated linearly in depth and held beyond its end rows, as MoorDyn's")
 
     def _environment(self) -> None:
         g = self._float_option("g", MOORDYN_G)
