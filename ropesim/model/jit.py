@@ -49,6 +49,7 @@ import types
 from dataclasses import dataclass
 
 from numba import njit
+from numba.core import types as numba_types
 from numba.core.registry import CPUDispatcher
 
 OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False}
@@ -59,10 +60,29 @@ def kernel(function=None, *, inline: str = "never"):
     (Numba's inlining at its own IR level, for small helpers called in the innermost loops)."""
     def decorate(fn):
         dispatcher = njit(inline=inline, **OPTIONS)(fn)
+        dispatcher.__class__ = Kernel
         dispatcher.ropesim_inline = inline   # for specialise's copies (Numba keeps no record of the jit options)
         return dispatcher
 
     return decorate(function) if function is not None else decorate
+
+
+class Kernel(CPUDispatcher):
+    """Numba's dispatcher, but a call from compiled code passes a constant integer as a plain integer.
+
+    Numba types an integer constant argument (``offset(m, j, 3, t)``, a stride of 1 or 2) as a literal, and
+    compiles the callee once for every constant it is called with: a driven rigid body's six degrees of freedom
+    compiled the motion law seven times (0.35 s each). A kernel never needs an integer argument to be a
+    literal (loops, strides and indices work on any integer), so it is compiled once, for int64. Boolean
+    constants stay literal: a callee's dead-branch pruning removes what a ``False`` argument switches off."""
+
+    def get_call_template(self, args, kws):
+        return super().get_call_template(tuple(_plain(a) for a in args), {k: _plain(a) for k, a in kws.items()})
+
+
+def _plain(numba_type):
+    """An integer literal's type as a plain integer (int64); any other type as it is."""
+    return numba_types.unliteral(numba_type) if isinstance(numba_type, numba_types.IntegerLiteral) else numba_type
 
 
 @dataclass(frozen=True)
