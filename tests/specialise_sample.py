@@ -49,7 +49,7 @@ def only_squares(a):
     return squares(a) if WITH_SQUARES else 0.0
 
 
-@jit.kernel
+@jit.kernel(literal_integers=False)
 def element(a, k):
     return a[k]
 
