@@ -47,3 +47,14 @@ def total(a):
 def only_squares(a):
     """Reads one switch alone."""
     return squares(a) if WITH_SQUARES else 0.0
+
+
+@jit.kernel(literal_integers=False)
+def element(a, k):
+    return a[k]
+
+
+@jit.kernel
+def first_three(a):
+    """Calls ``element`` with three integer constants."""
+    return element(a, 0) + element(a, 1) + element(a, 2)

@@ -80,6 +80,13 @@ def test_each_copy_computes_with_its_switches_and_is_made_once():
                                                                                                frozenset())
 
 
+def test_integer_constants_passed_to_a_kernel_compile_it_once():
+    """A kernel called from compiled code with three integer constants compiles once (Numba alone compiles it
+    for each constant, as a literal: a driven body's motion law seven times), and computes the same."""
+    assert sample.first_three(np.array([1.0, 2.0, 4.0, 8.0])) == 7.0
+    assert [str(s) for s in sample.element.signatures] == ["(Array(float64, 1, 'C', False, aligned=True), int64)"]
+
+
 def test_a_template_cannot_run_unspecialised():
     from numba.core.errors import TypingError
 

@@ -49,20 +49,43 @@ import types
 from dataclasses import dataclass
 
 from numba import njit
+from numba.core import types as numba_types
 from numba.core.registry import CPUDispatcher
 
 OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False}
 
 
-def kernel(function=None, *, inline: str = "never"):
+def kernel(function=None, *, inline: str = "never", literal_integers: bool = True):
     """Compile ``function`` as a ropesim kernel (see the module doc); ``@kernel`` or ``@kernel(inline="always")``
-    (Numba's inlining at its own IR level, for small helpers called in the innermost loops)."""
+    (Numba's inlining at its own IR level, for small helpers called in the innermost loops);
+    ``literal_integers=False``: compiled once for integer constants (:class:`PlainIntegers`)."""
     def decorate(fn):
         dispatcher = njit(inline=inline, **OPTIONS)(fn)
+        if not literal_integers:
+            dispatcher.__class__ = PlainIntegers
         dispatcher.ropesim_inline = inline   # for specialise's copies (Numba keeps no record of the jit options)
         return dispatcher
 
     return decorate(function) if function is not None else decorate
+
+
+class PlainIntegers(CPUDispatcher):
+    """Numba's dispatcher, but a call from compiled code passes a constant integer as a plain integer.
+
+    Numba types an integer constant argument (``offset(m, j, 3, t)``) as a literal, and compiles the callee
+    once for every constant it is called with: a driven rigid body's six degrees of freedom compiled the
+    motion law seven times (0.35 s each). A kernel made with ``literal_integers=False`` is compiled once, for
+    int64. Not the default: a constant stride or offset (``add_pair_springs(..., 2, ...)``) lets LLVM fold it
+    into the loop, and the stiff integrator's Newton matrix ran up to a fifth slower without it
+    (``scripts/bench_compare.py``, one loaded run). Boolean constants stay literal either way."""
+
+    def get_call_template(self, args, kws):
+        return super().get_call_template(tuple(_plain(a) for a in args), {k: _plain(a) for k, a in kws.items()})
+
+
+def _plain(numba_type):
+    """An integer literal's type as a plain integer (int64); any other type as it is."""
+    return numba_types.unliteral(numba_type) if isinstance(numba_type, numba_types.IntegerLiteral) else numba_type
 
 
 @dataclass(frozen=True)
@@ -145,7 +168,8 @@ def specialise(dispatcher, on: Switches):
         bits = sum(1 << i for i, value in enumerate(values) if value)
         clone.__qualname__ = f"{function.__qualname__}__s{bits:x}"   # its own entry in Numba's cache (COPY_SUFFIX)
         clone.__module__, clone.__doc__ = function.__module__, function.__doc__
-        copy = kernel(clone, inline=getattr(dispatcher, "ropesim_inline", "never"))
+        copy = kernel(clone, inline=getattr(dispatcher, "ropesim_inline", "never"),
+                      literal_integers=not isinstance(dispatcher, PlainIntegers))
         copy.ropesim_template = dispatcher
         _copies[key] = copy
     return copy

@@ -142,7 +142,7 @@ def ramp_factor(t, ramp):
             u * (60.0 + u * (-180.0 + 120.0 * u)) / (ramp * ramp))
 
 
-@jit.kernel
+@jit.kernel(literal_integers=False)   # rigid_state calls it with the axes 0 .. 5: one compile, not six
 def offset(m, j, d, t, t_piece):
     """(position, velocity, acceleration) of held node j's motion along axis d at time t, beyond x0 + V t; a
     path on its piece that holds time ``t_piece`` (see the module doc)."""
