@@ -159,7 +159,7 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
         def inverse(z: np.ndarray) -> None:
             solve(jac.band, jac.corner, cyclic, jac.band.shape[0] - 1, z, wood)
 
-        homogeneous = inverse
+        homogeneous = None
 
         def folded(z: np.ndarray) -> np.ndarray:
             return z
@@ -268,11 +268,13 @@ def _krylov_step(rhs: np.ndarray, inverse, extra, homogeneous=None) -> tuple[np.
     on which E does not act) and ``homogeneous(z)`` without it: d = d_b + A^-1 (y, 0) with d_b = A^-1 (0, r_b),
     and GMRES solves y + E A^-1 (y, 0) = rhs - E d_b. (r_b stays at its scale while the Krylov vectors are unit:
     taken out of A^-1 (v, r_b) - d_b, v's part would drown in the round-off of d_b.)"""
-    offset = np.zeros_like(rhs)
-    offset_unknowns = inverse(offset)        # d_b (zero without bodies)
+    offset, offset_unknowns = np.zeros_like(rhs), None
+    if homogeneous is None:                  # a rope: no own right-hand side
+        homogeneous = inverse
+    else:
+        offset_unknowns = inverse(offset)    # d_b (None without free bodies)
     if offset_unknowns is not None:
         rhs = rhs - extra(offset)
-    homogeneous = homogeneous or inverse
     beta = float(np.linalg.norm(rhs))
     if beta == 0.0:
         return offset, offset_unknowns
