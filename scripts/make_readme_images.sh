@@ -56,8 +56,8 @@ ropesim frames "$runs/cantilever_beam" --overlay --times 0,0.1,0.2,0.3,0.44 --wi
     -o "$out/cantilever_beam.png" -q
 ropesim plot "$runs/cantilever_beam" -o "$out/cantilever_beam_plot.png" -q
 
-# the systems of lines: the clump weight's drop and bounce, the driven and the free spar (seen from the side,
-# where the chains lift and lay down), and the sling load's swing (from the side) and turn (in 3-D)
+# the systems of lines: the clump weight's drop and bounce, the driven spar (seen from the side, where the chains
+# lift and lay down), the free spar held still by the current from its static start, and the sling load's swing (from the side) and turn (in 3-D)
 ropesim run clump_weight -o "$runs/clump_weight" -q
 ropesim frames "$runs/clump_weight" --overlay --times 0,0.2,0.4,0.6,0.8,1.0 --width 640 -o "$out/clump_weight.png" -q
 ropesim animate "$runs/clump_weight" --speed 0.5 --end 2 --fps 20 --size 400 -o "$out/clump_weight.gif" -q
@@ -67,9 +67,9 @@ ropesim frames "$runs/spread_mooring" --times 60 --width 760 -o "$out/spread_moo
 ropesim animate "$runs/spread_mooring" --view xy --speed 10 --fps 10 --size 400 -o "$out/spread_mooring.gif" -q
 ropesim plot "$runs/spread_mooring" -o "$out/spread_mooring_plot.png" -q
 ropesim run spread_mooring_free -o "$runs/spread_mooring_free" -q
-ropesim frames "$runs/spread_mooring_free" --overlay --view xy --times 0,50,100,150,300,600 --width 760 \
+ropesim frames "$runs/spread_mooring_free" --overlay --view xy --times 0,600 --width 760 \
     -o "$out/spread_mooring_free.png" -q
-ropesim animate "$runs/spread_mooring_free" --view xy --end 300 --speed 30 --fps 10 --size 400 \
+ropesim animate "$runs/spread_mooring_free" --view xy --speed 60 --fps 5 --size 400 \
     -o "$out/spread_mooring_free.gif" -q
 ropesim plot "$runs/spread_mooring_free" -o "$out/spread_mooring_free_plot.png" -q
 ropesim run helicopter_sling -o "$runs/helicopter_sling" -q

@@ -20,14 +20,15 @@ forces are in F). The Newton matrix's group block is then G^T J G over the attac
 the springs' stiffness beta^2 K and damping beta C at them, coupled to their lines through B) plus the body's own
 block (:func:`stage_rows`):
 
-    O = M - sum_c m_c G_c^T G_c (the plain masses the band already holds) + beta^2 K_phi + beta D,
+    O = M - sum_c m_c G_c^T G_c (the plain masses the band already holds) + beta^2 (K_phi + K_s) + beta D,
 
 K_phi = -sum [F]x [p]x the rotational geometric stiffness of the forces that turn with the body (its weight at
 its centre of gravity, its buoyancy at its centre of buoyancy, each attachment's force at its arm; see
 :mod:`ropesim.model.body_groups`), and D = -dF/dW: the gyroscopic moment's [w]x I - [I w]x, the centripetal
 forces' -M_p ([w x p]x + [w]x [p]x) at each mass's arm p, and the drag's and rotational drag's
-R diag(d) (|u| I + u u^T / |u|) R^T. Left out: the dependence of the centripetal and drag terms on the
-orientation (O(beta^2 w^2)), which only slows Newton's convergence, never changes its solution.
+R diag(d) (|u| I + u u^T / |u|) R^T and a free body's linear damper diag(c) on its translation; K_s = diag(k)
+its linear spring's. Left out: the dependence of the centripetal and drag terms on the orientation
+(O(beta^2 w^2)), which only slows Newton's convergence, never changes its solution.
 
 Stored in :class:`BodyStage`; everything here runs behind the bodies switch.
 """
@@ -260,6 +261,10 @@ def stage_rows(body, X, acc, beta, t, p, groups, rhs):
         wb = rotate_back(r, w0, w1, w2)
         _add_drag_rate(own, 3, r, bodies.drag_rot[0, b], bodies.drag_rot[1, b], bodies.drag_rot[2, b], wb[0], wb[1],
                        wb[2], beta)
+        # the linear spring and damper on the reference point: beta^2 k + beta c on its translation
+        for a in range(3):
+            if bodies.spring[a, b] != 0.0 or bodies.damper[a, b] != 0.0:
+                own[a, a] += beta * beta * bodies.spring[a, b] + beta * bodies.damper[a, b]
         at = first + b * k
         for a in range(k):
             groups.own_rhs[at + a] = work[keep[a], 6]

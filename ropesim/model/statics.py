@@ -139,6 +139,15 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
             schur_solve(jac.band, w, p.lines, groups, z)
             return bodies.step() if bodies is not None else None   # the bodies' unknowns
 
+        def homogeneous(z: np.ndarray) -> np.ndarray | None:
+            """inverse without the bodies' own right-hand side"""
+            own = groups.own_rhs.copy()
+            groups.own_rhs[:] = 0.0
+            try:
+                return inverse(z)
+            finally:
+                groups.own_rhs[:] = own
+
         def folded(z: np.ndarray) -> np.ndarray:
             if junctions is not None:
                 fold_junctions(z, junctions, dim)
@@ -149,6 +158,8 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
 
         def inverse(z: np.ndarray) -> None:
             solve(jac.band, jac.corner, cyclic, jac.band.shape[0] - 1, z, wood)
+
+        homogeneous = None
 
         def folded(z: np.ndarray) -> np.ndarray:
             return z
@@ -191,7 +202,8 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
         if blocks is None or not blocks.any():
             du = inverse(step)
         else:
-            step, du = _krylov_step(step, inverse, lambda z: tau * tau * folded(_apply_blocks(blocks, z, free)))
+            step, du = _krylov_step(step, inverse, lambda z: tau * tau * folded(_apply_blocks(blocks, z, free)),
+                                     homogeneous)
         largest = float(np.abs(step).max())
         shorten = reach / largest if largest > reach else 1.0
         if du is not None:     # a body turns by at most MAX_TURN in one step
@@ -247,19 +259,31 @@ def _apply_blocks(blocks: np.ndarray, z: np.ndarray, free: np.ndarray) -> np.nda
     return out.reshape(-1)
 
 
-def _krylov_step(rhs: np.ndarray, inverse, extra) -> tuple[np.ndarray, np.ndarray | None]:
+def _krylov_step(rhs: np.ndarray, inverse, extra, homogeneous=None) -> tuple[np.ndarray, np.ndarray | None]:
     """Solve (A + E) d = rhs by GMRES, right-preconditioned by A: ``inverse(z)`` overwrites z with A^-1 z (the
     factored banded matrix) and returns the free bodies' unknowns of it (or None), ``extra(z)`` returns E z. From
-    d = 0; stops at KRYLOV_TOL or KRYLOV_DIMENSION vectors, returning the best d so far and its bodies' unknowns."""
+    d = 0; stops at KRYLOV_TOL or KRYLOV_DIMENSION vectors, returning the best d so far and its bodies' unknowns.
+
+    With free bodies, ``inverse`` also solves for the bodies' own right-hand side r_b (their rows of the system,
+    on which E does not act) and ``homogeneous(z)`` without it: d = d_b + A^-1 (y, 0) with d_b = A^-1 (0, r_b),
+    and GMRES solves y + E A^-1 (y, 0) = rhs - E d_b. (r_b stays at its scale while the Krylov vectors are unit:
+    taken out of A^-1 (v, r_b) - d_b, v's part would drown in the round-off of d_b.)"""
+    offset, offset_unknowns = np.zeros_like(rhs), None
+    if homogeneous is None:                  # a rope: no own right-hand side
+        homogeneous = inverse
+    else:
+        offset_unknowns = inverse(offset)    # d_b (None without free bodies)
+    if offset_unknowns is not None:
+        rhs = rhs - extra(offset)
     beta = float(np.linalg.norm(rhs))
     if beta == 0.0:
-        return np.zeros_like(rhs), None
+        return offset, offset_unknowns
     basis, preconditioned, unknowns = [rhs / beta], [], []
     hessenberg = np.zeros((KRYLOV_DIMENSION + 1, KRYLOV_DIMENSION))
     coefficients = np.zeros(1)
     for k in range(KRYLOV_DIMENSION):
         z = basis[k].copy()
-        unknowns.append(inverse(z))
+        unknowns.append(homogeneous(z))
         preconditioned.append(z)
         w = basis[k] + extra(z)                  # (A + E) A^-1 v
         for _ in range(2):                       # Gram-Schmidt twice: orthogonal to round-off
@@ -275,10 +299,10 @@ def _krylov_step(rhs: np.ndarray, inverse, extra) -> tuple[np.ndarray, np.ndarra
         if residual <= KRYLOV_TOL * beta or hessenberg[k + 1, k] <= 1e-300:
             break
         basis.append(w / hessenberg[k + 1, k])
-    step = sum(c * z for c, z in zip(coefficients, preconditioned))
-    if unknowns[0] is None:
+    step = offset + sum(c * z for c, z in zip(coefficients, preconditioned))
+    if offset_unknowns is None:
         return step, None
-    return step, sum(c * u for c, u in zip(coefficients, unknowns))
+    return step, offset_unknowns + sum(c * u for c, u in zip(coefficients, unknowns))
 
 
 @jit.kernel
