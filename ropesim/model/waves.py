@@ -211,6 +211,39 @@ def table_components(rows, depth: float, g: float) -> Components:
                       np.radians(rows[:, 2]), np.radians(rows[:, 3]))
 
 
+def components_of(waves, depth: float, g: float) -> Components:
+    """The components of a scene's ``[waves]`` (a resolved :class:`ropesim.scene.schema.Waves`) on water ``depth``
+    [m] deep under gravity ``g`` [m/s^2]."""
+    direction = math.radians(waves.direction)
+    if waves.kind == "regular":
+        return regular_component(waves.height, waves.period, math.radians(waves.phase), direction, depth, g)
+    if waves.kind == "table":
+        return table_components(waves.table, depth, g)
+    gamma = waves.gamma if waves.kind == "jonswap" else 1.0
+    return spectral_components(waves.significant_height, waves.peak_period, gamma, waves.components,
+                               waves.frequency_range, depth, g, waves.seed, direction)
+
+
+def water_depth(scene) -> float:
+    """The depth [m] a scene's waves feel: ``sea.depth``, else the mean level above the seabed, else deep water
+    (inf)."""
+    sea = scene.sea
+    if sea.depth is not None:
+        return sea.depth
+    if scene.seabed is not None:
+        return sea.level - scene.seabed.height
+    return DEEP
+
+
+def wave_field(scene) -> "WaveField | None":
+    """A scene's waves (None without ``[sea]`` and ``[waves]``)."""
+    if scene.sea is None or scene.waves is None:
+        return None
+    depth, g = water_depth(scene), scene.gravity.g
+    return WaveField(components_of(scene.waves, depth, g), scene.sea.level, depth, g, scene.waves.ramp_time,
+                     scene.waves.stretching)
+
+
 def steepest(components: Components) -> tuple[float, int]:
     """(largest H / L = 2 a k / (2 pi) of any component, its index)."""
     steep = components.amplitude * components.k / math.pi
