@@ -226,7 +226,7 @@ def test_sea_and_waves_keys_refused_with_one_line(tmp_path):
         "[waves]\nkind = \"table\"\ntable_file = \"comps.csv\"\n": "waves.table_file",
         "[waves]\nkind = \"regular\"\nheight = 1.0\nperiod = 5.0\nseed = 3\n": "waves.seed",
         "[waves]\nkind = \"swell\"\n": "waves.kind",
-        "[added_mass]\nca_normal = 1.0\n": "added_mass",
+        "[viscous_drag]\nb_normal = 1.0\nb_tangential = 0.1\n": "viscous_drag",
     }
     (tmp_path / "comps.csv").write_text("amplitude,frequency,phase\n0.5,1.0,0\n")
     for extra, key in cases.items():
@@ -239,3 +239,50 @@ def test_sea_and_waves_keys_refused_with_one_line(tmp_path):
         assert key in lines[0] and "s.toml" in lines[0], lines[0]
         if key == "waves.table_file":
             assert "no 'direction' column" in lines[0]
+
+
+@pytest.mark.parametrize("name, sets", [
+    ("buoy_tether", ["integrator.t_end=10.0", "output.interval=1.0"]),
+    pytest.param("buoy_tether", ["integrator.method=rk4", "integrator.dt=5e-4", "integrator.t_end=2.0",
+                                 "output.interval=0.5"], marks=pytest.mark.slow),
+    pytest.param("spread_mooring", ["integrator.t_end=10.0", "output.interval=1.0"], marks=pytest.mark.slow),
+])
+def test_a_surface_above_everything_changes_nothing(name, sets):
+    """A scene wholly under water runs the same with a [sea] above it as without: the buoyancy, the drag in the
+    current, the added mass (a line's, a body's; rewritten from the submerged fractions at every evaluation)
+    and the ramping current's inertia force all on the whole of every node (to round-off: the sea's term
+    evaluates the same forces in another order)."""
+    scene = ropesim.load_scene(ROOT / "scenarios" / f"{name}.toml", sets)
+    from dataclasses import replace
+
+    from ropesim.scene.schema import Sea
+
+    wet = replace(scene, sea=Sea(level=10.0))
+    assert "sea" in switches(wet) and "flow_inertia" not in switches(wet)
+    dry, sea = ropesim.simulate(scene), ropesim.simulate(wet)
+    assert np.ptp(dry.x[:, :, 0]) > 1e-3   # it moves
+    assert np.abs(sea.x - dry.x).max() < 1e-9
+    assert np.abs(sea.v - dry.v).max() < 1e-8
+
+
+@pytest.mark.parametrize("ca", [0.0, 1.0])
+def test_a_floating_line_heaves_at_its_natural_period(ca):
+    """A hose of half the water's density floats half under (its axis at the surface). Lifted by 1 % of its
+    radius and let go (no drag), it heaves at omega^2 = rho g 2 r / (m' + f rho A Ca), f = 1/2 of its added
+    mass in the water: 4 g / (pi r) without added mass, 2 g / (pi r) with Ca = 1 (rk4; the period from the
+    zero crossings, to 0.2 %: the amplitude's nonlinearity is of order 1e-4)."""
+    r = 0.05
+    area = math.pi * r * r
+    mu = 0.5 * RHO * area
+    text = hose(mu, 2 * r, y=0.01 * r).replace("EA = 1.0e6", "EA = 1.0e4").replace(
+        'method = "sdirk2"\ndt = 0.01\nt_end = 1.0', 'method = "rk4"\ndt = 0.002\nt_end = 3.0')
+    if ca:
+        text += f"[added_mass]\nca_normal = {ca}\n"
+    traj = ropesim.simulate(scene_of(text, ["output.interval=0.002"]))
+    y = traj.x[:, 10, 1]
+    down = np.nonzero((y[:-1] > 0) & (y[1:] <= 0))[0]
+    crossings = traj.t[down] + y[down] / (y[down] - y[down + 1]) * 0.002   # interpolated linearly
+    period = np.diff(crossings).mean()
+    omega2 = RHO * G * 2 * r / (mu + 0.5 * RHO * area * ca)
+    assert len(crossings) >= 3
+    assert period == pytest.approx(2 * math.pi / math.sqrt(omega2), rel=2e-3)

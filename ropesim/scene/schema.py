@@ -265,13 +265,13 @@ class AddedMass:
 @dataclass(frozen=True)
 class Sea:
     """A free surface at the mean water level y = ``level``: water (``[fluid]``) below it, air above. Buoyancy,
-    drag and the water's inertia force (Froude-Krylov) act on the submerged part of each node alone, its
+    drag, added mass and the water's inertia force act on the submerged part of each node alone, its
     fraction below the instantaneous surface: a node's share of its line is two half segments, each a cylinder
     of the line's diameter cut by the surface (a floating line rests at Archimedes' draught); a point body, a
     sphere of its volume. The part in air feels drag with the air's density on its velocity relative to the
     ``wind``, and no buoyancy. A ``[flow]`` is the current in the water. ``[waves]`` move the surface; without
-    them the water is still. Not yet combined with a sea: ``[added_mass]``, ``[drag]``, ``[viscous_drag]`` and
-    free rigid bodies."""
+    them the water is still. Not combined with a sea (yet): ``[drag]``, ``[viscous_drag]`` and free rigid
+    bodies."""
 
     level: float = spec("float", "height y of the mean water level", "m", default=0.0)
     depth: float | None = spec("float", "water depth the waves feel (default: level - seabed.height; without a "

@@ -28,8 +28,6 @@ NOT_WITH_A_SEA = {
             "[fluid_drag]",
     "viscous_drag": "[viscous_drag] is linear drag in one fluid everywhere; with a [sea] (water below the surface, "
                     "air above) use [fluid_drag]",
-    "added_mass": "added mass does not yet follow a [sea]'s surface (it would act on the part in air too); leave "
-                  "out [added_mass] with a [sea]",
 }
 
 

@@ -20,10 +20,14 @@ with a volume) is a sphere of its volume: f_b = (u + 1)^2 (2 - u) / 4, u = (surf
 - buoyancy on the submerged part only: ``[buoyancy]`` keeps its push rho V g on the whole volume (and its
   potential energy), and this term takes away the part above the surface, -rho g (V_line (1 - f) +
   V_body (1 - f_b)), booked as the fluid's work;
-- the water's inertia force on the submerged part, Froude-Krylov (the pressure gradient that accelerates the
-  water): (f rho V_line + f_b rho V_body) a_w with ``[buoyancy]``, a_w the water's acceleration (the waves'
-  du/dt, and a ramping current's); MoorDyn's Ap and Aq with Ca = 0 (added mass is not yet combined with a sea:
-  the loader refuses ``[added_mass]`` with ``[sea]``);
+- added mass on the submerged part: the node's mass matrix m I + f A_line + f_b A_body. :func:`water_state`
+  rewrites the live coefficients the added-mass pass, the free points' solve and the Newton matrix read
+  (``ModelParams.added_mass``, ``Junctions.added``) from their bases (this bundle's rows) at every evaluation,
+  before they are read;
+- the water's inertia force on the submerged part, MoorDyn's Froude-Krylov plus added-mass force (its Ap and
+  Aq): f rho V_line [(b + Ca_n) a_n + (b + Ca_t) a_t] + f_b rho V_body (b + Ca) a_w, a_w the water's local
+  acceleration (the waves' du/dt, and a ramping current's) split along the node tangent; b = 1 with
+  ``[buoyancy]`` (the pressure gradient that accelerates the water), the Ca parts with added mass;
 - drag (``[fluid_drag]``, a point body's ``cd_area``): the water's on the fraction f of the node (f_b of its
   body) on the velocity relative to the water, u_w = U_current + u_waves, and the air's on the rest, the same
   coefficients times rho_air / rho_water, on the velocity relative to the ``wind``. Air adds no buoyancy.
@@ -55,10 +59,12 @@ from collections import namedtuple
 import numpy as np
 
 from . import Term
+from .added_mass import ADDED_MASS_TERM, WITH_ADDED_MASS
 from .fluid import (WITH_BODY_DRAG, WITH_FLOW, WITH_FLUID_DRAG, flow_at, flow_scaled, morison_damping,
                     node_tangent)
 from .flow_inertia import ramp_rate
-from ..layout import line_volumes, lumped_bodies, per_node
+from ..junctions import WITH_JUNCTIONS
+from ..layout import junctions, line_volumes, lumped_bodies, per_node
 from ..waves import (COMP_ROWS, LEVEL, NODE_ROWS, WAVE_SCALARS, compiled_tables, node_kinematics, wave_field)
 from .. import jit
 
@@ -72,9 +78,9 @@ AIR_RATIO, WIND_X, WIND_Y, WIND_Z = range(WAVE_SCALARS, WAVE_SCALARS + 4)
 SCALAR_COUNT = WAVE_SCALARS + 4
 
 # per-node rows of Sea.nodes: constants, then the state of the last evaluation, then scratch
-(LIFT_LINE, LIFT_BODY, RADIUS, SPHERE, K_LINE, K_BODY, HALF_LO, HALF_HI,
- ETA, UX, UY, UZ, AX, AY, AZ, F_LINE, F_BODY) = range(17)
-WORK = 17
+(LIFT_LINE, LIFT_BODY, RADIUS, SPHERE, KN, KT, KB, AN, AT, AB, OWNED, HALF_LO, HALF_HI,
+ ETA, UX, UY, UZ, AX, AY, AZ, F_LINE, F_BODY) = range(22)
+WORK = 22
 NODE_STATE_ROWS = WORK + NODE_ROWS
 
 
@@ -199,6 +205,22 @@ def water_state(x, p, t):
         surface = level + nodes[ETA, i]
         nodes[F_LINE, i] = line_fraction(x, i, p.neighbours, surface, nodes)[0]
         nodes[F_BODY, i] = sphere_fraction(x[1, i], surface, nodes[SPHERE, i])[0] if nodes[SPHERE, i] > 0.0 else 1.0
+    if WITH_ADDED_MASS:
+        for i in range(n):
+            if nodes[OWNED, i] == 0.0:
+                _live_added(p.added_mass, i, i, nodes)
+        if WITH_JUNCTIONS:
+            points = p.junctions
+            for k in range(points.nodes.shape[0]):
+                _live_added(points.added, k, points.nodes[k], nodes)
+
+
+@jit.kernel(inline="always")
+def _live_added(added, k, i, nodes):
+    """Column k of the live added-mass coefficients (2, K) from node i's bases and submerged fractions."""
+    fl, fb = nodes[F_LINE, i], nodes[F_BODY, i]
+    added[0, k] = nodes[AN, i] * fl + nodes[AB, i] * fb
+    added[1, k] = nodes[AT, i] * fl + nodes[AB, i] * fb
 
 
 # -------------------------------------------------------------------------------------------- forces
@@ -214,14 +236,20 @@ def add_sea_forces(x, v, acc, p):
     for i in range(n):
         fl, fb = nodes[F_LINE, i], nodes[F_BODY, i]
         lift = nodes[LIFT_LINE, i] * (1.0 - fl) + nodes[LIFT_BODY, i] * (1.0 - fb)
-        k = fl * nodes[K_LINE, i] + fb * nodes[K_BODY, i]
-        a0 = k * nodes[AX, i]
-        a1 = k * nodes[AY, i] - lift
+        a0 = a1 = a2 = 0.0
+        if nodes[KN, i] != 0.0 or nodes[KT, i] != 0.0 or nodes[KB, i] != 0.0:
+            w0, w1, w2 = nodes[AX, i], nodes[AY, i], nodes[AZ, i] if dim == 3 else 0.0
+            q0, q1, q2 = node_tangent(x, i, p.neighbours)
+            along = w0 * q0 + w1 * q1 + w2 * q2
+            kn, kt, kb = fl * nodes[KN, i], fl * nodes[KT, i], fb * nodes[KB, i]
+            a0 = kn * (w0 - along * q0) + kt * along * q0 + kb * w0
+            a1 = kn * (w1 - along * q1) + kt * along * q1 + kb * w1
+            a2 = kn * (w2 - along * q2) + kt * along * q2 + kb * w2
+        a1 -= lift
         acc[0, i] += a0
         acc[1, i] += a1
         power += (a0 * v[0, i] + a1 * v[1, i]) / p.inv_mass[i]
         if dim == 3:
-            a2 = k * nodes[AZ, i]
             acc[2, i] += a2
             power += a2 * v[2, i] / p.inv_mass[i]
     return power
@@ -337,21 +365,34 @@ def add_sea_jacobian(x, v, band, beta, free, p):
 
 def sea_nodes(scene, layout) -> np.ndarray:
     """The constant per-node rows of :class:`Sea` (module doc): the lift of the line and of the body, their
-    radii, the Froude-Krylov factors and each node's unstretched half segments."""
+    radii, the inertia force's factors, the added masses' bases (and which nodes' the free points' solve owns)
+    and each node's unstretched half segments."""
     n = len(layout.mass)
     nodes = np.zeros((NODE_STATE_ROWS, n))
     rho = scene.fluid.density
     line_volume = line_volumes(layout.lines, layout.node_length)
-    body_volume = np.zeros(n)
+    body_volume, body_ca = np.zeros(n), np.zeros(n)
     for body in lumped_bodies(scene, layout.lines):
         body_volume[body.node] += body.volume
-    if scene.buoyancy is not None:   # the pressure field: buoyancy, and its dynamic side, Froude-Krylov
+        body_ca[body.node] = body.ca
+    if scene.buoyancy is not None:
         g = scene.gravity.g
         nodes[LIFT_LINE] = rho * g * line_volume / layout.mass
         nodes[LIFT_BODY] = rho * g * body_volume / layout.mass
-        free = ~layout.held
-        nodes[K_LINE] = np.where(free, rho * line_volume / layout.mass, 0.0)
-        nodes[K_BODY] = np.where(free, rho * body_volume / layout.mass, 0.0)
+    froude = 1.0 if scene.buoyancy is not None else 0.0   # the pressure field's dynamic side, with buoyancy
+    lines = scene.added_mass is not None   # as the added-mass term lumps them
+    ca_n = per_node(layout.lines, n, [line.ca_normal for line in layout.lines]) if lines else np.zeros(n)
+    ca_t = per_node(layout.lines, n, [line.ca_tangential for line in layout.lines]) if lines else np.zeros(n)
+    ca_b = body_ca if ADDED_MASS_TERM.declared(scene) else np.zeros(n)
+    free = ~layout.held
+    nodes[KN] = np.where(free, rho * line_volume * (froude + ca_n) / layout.mass, 0.0)
+    nodes[KT] = np.where(free, rho * line_volume * (froude + ca_t) / layout.mass, 0.0)
+    nodes[KB] = np.where(free, rho * body_volume * (froude + ca_b) / layout.mass, 0.0)
+    nodes[AN] = np.where(free, rho * line_volume * ca_n, 0.0)
+    nodes[AT] = np.where(free, rho * line_volume * ca_t, 0.0)
+    nodes[AB] = np.where(free, rho * body_volume * ca_b, 0.0)
+    owned = [i for group in junctions(scene, layout.lines) for i in group]
+    nodes[OWNED, owned] = 1.0
     nodes[RADIUS] = per_node(layout.lines, n, [0.5 * (line.diameter or 0.0) for line in layout.lines])
     nodes[SPHERE] = np.cbrt(3.0 * body_volume / (4.0 * math.pi))
     for line in layout.lines:
