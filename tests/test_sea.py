@@ -286,3 +286,26 @@ def test_a_floating_line_heaves_at_its_natural_period(ca):
     omega2 = RHO * G * 2 * r / (mu + 0.5 * RHO * area * ca)
     assert len(crossings) >= 3
     assert period == pytest.approx(2 * math.pi / math.sqrt(omega2), rel=2e-3)
+
+
+def test_the_viewer_draws_the_sea():
+    """A run's page shows the sea: in 2-D its mean level, in 3-D with waves a grid that moves with them, each
+    frame's heights the waves' elevation there (the page itself is tested by tests/test_viewer_browser.py)."""
+    from ropesim.model.waves import wave_field
+    from ropesim.viewer.content import run_content
+
+    flat = run_content(ropesim.simulate(scene_of(hose(4.0), ["integrator.t_end=0.05", "output.interval=0.01"])))
+    assert flat.water.height == 0.0 and flat.water.heights is None
+    text = hose(4.0).replace("dimension = 2", "dimension = 3").replace("[0.0, 0.0]", "[0.0, 0.0, 0.0]").replace(
+        "[20.0, 0.0]", "[20.0, 0.0, 0.0]").replace("level = 0.0", "level = -1.0")
+    text += '[waves]\nkind = "regular"\nheight = 0.5\nperiod = 6.0\ndirection = 30.0\n'
+    scene = scene_of(text, ["integrator.t_end=0.3", "output.interval=0.1"])
+    content = run_content(ropesim.simulate(scene))
+    water = content.water
+    assert water.heights.shape == (4, 33, 33)
+    assert water.x[0] < 0.0 and water.x[-1] > 20.0
+    field = wave_field(scene)
+    for frame in (0, 3):
+        expect = -1.0 + field.elevation(water.x[:, None], content.t[frame], water.z[None, :])
+        assert np.allclose(water.heights[[frame]][0], expect, rtol=0, atol=1e-12)
+    assert np.ptp(water.heights[[3]]) > 0.4
