@@ -42,6 +42,7 @@ KINDS = {
     "dofs": "per degree of freedom",
     "dof_rows": "table",
     "inertia": "inertia",
+    "wave_rows": "table",
 }
 
 # What a key left out means when the schema's default is None ("work it out from the rest of the scene").
@@ -72,6 +73,17 @@ WHEN_ABSENT = {
     "driven.velocity": "zero (only the sinusoid or the path moves the node)",
     "driven.phase": "zero on every axis",
     "thrower.omega0": "4π |v_max| / L",
+    "sea.depth": "`level` − `seabed.height` with a `[seabed]`, else deep water",
+    "sea.wind": "still air",
+    "waves.height": "**required** for `regular`",
+    "waves.period": "**required** for `regular`",
+    "waves.significant_height": "**required** for `jonswap` and `pierson_moskowitz`",
+    "waves.peak_period": "**required** for `jonswap` and `pierson_moskowitz`",
+    "waves.gamma": "DNV-RP-C205's: 5 for Tp/√Hs ≤ 3.6, exp(5.75 − 1.15 Tp/√Hs) up to 5, then 1",
+    "waves.components": "`100` for a spectrum",
+    "waves.frequency_range": "0.5 and 3 times the peak frequency 2π/Tp",
+    "waves.table": "`table_file`'s rows (**required** one way or the other for `table`)",
+    "waves.table_file": "none: the rows are inline in `table`",
     "guides.omega0": "the thrower's ω0 (required without a `[thrower]`)",
     # systems: a line type, a line (its type's value, else ...), a point, a rigid body
     "line_types.mass_per_length": "`density` × π d² / 4 when both are given",
@@ -163,6 +175,7 @@ def allowed(spec) -> str:
         "int_list": "a list of indices, or one; −N to N−1",
         "points": "N vectors",
         "rows": "rows of t and `dimension` numbers, t increasing",
+        "wave_rows": "rows of 4 numbers: amplitude > 0, angular frequency > 0, phase, direction",
         "angles": "3 numbers in 3-D (about x, y, z), 1 in 2-D (about z)",
         "dofs": "6 numbers in 3-D (x, y, z, then about x, y, z), 3 in 2-D (x, y, about z)",
         "dof_rows": "rows of t and one number per degree of freedom (6 in 3-D, 3 in 2-D), t increasing",

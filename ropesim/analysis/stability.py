@@ -85,13 +85,16 @@ def inertial_mass(model: Model) -> np.ndarray:
     tangential added mass (the direction in which the fluid adds least inertia oscillates fastest); nodes that
     move together all on their representative (:func:`representatives`), the others' entries left as theirs."""
     added = model.params.added_mass
+    if model.scene.sea is not None:   # a node in air has none (the sea rewrites the coefficients as it runs)
+        added = np.zeros_like(added)
     mass = model.mass + added.min(axis=0) if added.size else model.mass
     junctions = model.params.junctions
     if junctions is not None:
         rep = representatives(model)
         together = np.zeros(model.nodes)
         np.add.at(together, rep, mass)
-        np.add.at(together, rep[junctions.nodes], junctions.added.min(axis=0))   # left out of the per-node pass
+        if model.scene.sea is None:
+            np.add.at(together, rep[junctions.nodes], junctions.added.min(axis=0))   # left out of the per-node pass
         mass = np.where(rep == np.arange(model.nodes), together, mass)
     return mass
 

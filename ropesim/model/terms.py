@@ -40,6 +40,7 @@ from .forces.fluid import (BODY_DRAG_TERM, FLOW_PUSH_TERM, FLOW_TERM, FLUID_DRAG
                            WITH_BODY_DRAG, WITH_FLOW_PUSH, WITH_FLUID_DRAG, WITH_VISCOUS_DRAG, add_fluid_forces,
                            add_fluid_jacobian)
 from .forces.flow_inertia import FLOW_INERTIA_TERM, WITH_FLOW_INERTIA, add_flow_inertia
+from .forces.sea import SEA_TERM, WITH_SEA, WITH_WAVES, add_sea_drag, add_sea_forces, add_sea_jacobian, water_state
 from .forces.gravity import GRAVITY as GRAVITY_TERM
 from .forces.gravity import WITH_GRAVITY
 from .forces.guides import GUIDES as GUIDES_TERM
@@ -62,7 +63,7 @@ from . import jit
 
 TERMS = (ROPE, BENDING_TERM, GRAVITY_TERM, BUOYANCY_TERM, THROWER_TERM, GUIDES_TERM, AXIAL_DAMPING_TERM,
          FLUID_DRAG_TERM, VISCOUS_DRAG_TERM, BODY_DRAG_TERM, FLOW_TERM, FLOW_PUSH_TERM, ADDED_MASS_TERM, SEABED_TERM,
-         EI_TERM, FLOW_INERTIA_TERM)
+         EI_TERM, FLOW_INERTIA_TERM, SEA_TERM)
 
 WITH_VELOCITY_TERMS = jit.Switch("velocity_terms", "a term beyond the thrower's and guides' depends on velocity "
                                                    "(Term.velocity)")
@@ -72,7 +73,7 @@ WITH_MOTION = jit.Switch("motion", "a held node with a prescribed motion beyond 
 ModelParams = namedtuple("ModelParams", [
     "inv_mass", "node_length", "lines", "neighbours", "junctions", "bodies", "spring", "bending", "gravity", "buoyancy",
     "thrower", "guides", "axial", "fluid_drag", "viscous_drag", "body_drag", "flow", "flow_push", "added_mass",
-    "seabed", "bending_ei", "flow_inertia"])
+    "seabed", "bending_ei", "flow_inertia", "sea"])
 """What the compiled code knows of the model's forces: 1 / m per node (N,), each node's share of unstretched
 length (N,) [m], the lines' nodes (L, 2) (first, one past the last: :func:`ropesim.model.layout.line_table`),
 the nodes whose chord gives each node's tangent (2, N) (:func:`ropesim.model.forces.fluid.neighbours`), a
@@ -113,6 +114,8 @@ def switches(scene) -> jit.Switches:
     on = {term.switch.name for term in declared if term.switch is not None}
     if any(line.closed for line in line_layouts(scene)):
         on.add(WITH_WRAP_AROUND.name)
+    if WITH_SEA.name in on and scene.waves is not None:
+        on.add(WITH_WAVES.name)
     if junctions(scene):
         on.add(WITH_JUNCTIONS.name)
     if free_bodies(scene):
@@ -167,7 +170,12 @@ def velocity_accelerations(x, v, acc, p, t):
                 internal += add_axial_damping(x, v, acc, p.inv_mass, p.axial[line], p.spring[line, 2] != 0.0,
                                               p.lines[line, 0], p.lines[line, 1])
     fluid = 0.0
-    if WITH_FLUID_DRAG or WITH_VISCOUS_DRAG or WITH_BODY_DRAG or WITH_FLOW_PUSH:
+    if WITH_SEA:   # water below the surface, air above: drag split, buoyancy and inertia on the wet part
+        water_state(x, p, t)
+        if WITH_FLUID_DRAG or WITH_BODY_DRAG:
+            fluid = add_sea_drag(x, v, acc, p)
+        fluid += add_sea_forces(x, v, acc, p)
+    elif WITH_FLUID_DRAG or WITH_VISCOUS_DRAG or WITH_BODY_DRAG or WITH_FLOW_PUSH:
         fluid = add_fluid_forces(x, v, acc, p, t)
     if WITH_FLOW_INERTIA:
         fluid += add_flow_inertia(x, v, acc, p.inv_mass, p.flow_inertia, p.flow, t, p.neighbours)
@@ -312,7 +320,10 @@ def node_jacobian(x, v, band, beta, mass, free, p, t):
         add_thrower_jacobian(x, band, beta, mass, free, p.thrower)
     if WITH_GUIDES:
         add_guides_jacobian(x, v, band, beta, mass, free, p.guides, p.thrower, WITH_THROWER)
-    if WITH_FLUID_DRAG or WITH_VISCOUS_DRAG or WITH_BODY_DRAG:
+    if WITH_SEA:
+        water_state(x, p, t)
+        add_sea_jacobian(x, v, band, beta, free, p)
+    elif WITH_FLUID_DRAG or WITH_VISCOUS_DRAG or WITH_BODY_DRAG:
         add_fluid_jacobian(x, v, band, beta, free, p, t)
     if WITH_ADDED_MASS:
         add_added_mass_jacobian(x, band, p.added_mass, free, p.neighbours)

@@ -17,6 +17,7 @@ from .builtin import resolve
 from .errors import SceneError
 from .material import agree, mass_per_length, per_node, resolve_axial_damping
 from .motion import complete_motion
+from .sea import resolve_sea
 from .system import (POINT_BODY_IN_A_SYSTEM, RIGID_BODY_IN_A_ROPE, ROPE_ONLY_INSTEAD, SYSTEM_ONLY_INSTEAD,
                      resolve_system)
 from .values import (MAX_MAGNITUDE, MAX_SCENE_BYTES, MIN_POSITIVE, check_name, choices_text, parse_value, show,
@@ -337,7 +338,7 @@ def _check_system(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
     _check_fluid(scene, fail)
     _check_flow_covers_the_start(scene, fail)
     _check_seabed(scene, fail)
-    return scene
+    return resolve_sea(scene, base_dir, fail)
 
 
 def _check_scene(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
@@ -354,7 +355,7 @@ def _check_scene(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
     scene = _resolve_omegas(scene, fail)
     _check_flow_covers_the_start(scene, fail)
     _check_seabed(scene, fail)
-    return scene
+    return resolve_sea(scene, base_dir, fail)
 
 
 def _resolve_driven(scene: S.Scene, base_dir: Path, fail) -> S.Scene:

@@ -265,6 +265,78 @@ class AddedMass:
 
 
 @dataclass(frozen=True)
+class Sea:
+    """A free surface at the mean water level y = ``level``: water (``[fluid]``) below it, air above. Buoyancy,
+    drag, added mass and the water's inertia force act on the submerged part of each node alone, its
+    fraction below the instantaneous surface: a node's share of its line is two half segments, each a cylinder
+    of the line's diameter cut by the surface (a floating line rests at Archimedes' draught); a point body, a
+    sphere of its volume. The part in air feels drag with the air's density on its velocity relative to the
+    ``wind``, and no buoyancy. A ``[flow]`` is the current in the water. ``[waves]`` move the surface; without
+    them the water is still. Not combined with a sea (yet): ``[drag]``, ``[viscous_drag]`` and free rigid
+    bodies."""
+
+    level: float = spec("float", "height y of the mean water level", "m", default=0.0)
+    depth: float | None = spec("float", "water depth the waves feel (default: level - seabed.height; without a "
+                                        "seabed, deep water)", "m", default=None, required=False, low=0,
+                               open_low=True)
+    air_density: float = spec("float", "the air's density above the surface (its drag)", "kg/m^3", default=1.225,
+                              low=0)
+    wind: tuple | None = spec("vector", "the wind's velocity above the surface (default: still air)", "m/s",
+                              default=None, required=False)
+
+
+WAVE_KINDS = ("regular", "jonswap", "pierson_moskowitz", "table")
+
+
+@dataclass(frozen=True)
+class Waves:
+    """Linear (Airy) waves on the ``[sea]``, each component satisfying the finite-depth dispersion relation
+    w^2 = g k tanh(k d) exactly, their kinematics stretched to the instantaneous surface (Wheeler) and ramped
+    in over ``ramp_time``, plus the ``[flow]``'s current:
+
+    - ``kind = "regular"``: an Airy wave of ``height`` H and ``period`` T;
+    - ``"jonswap"`` (``significant_height`` Hs, ``peak_period`` Tp, ``gamma``) or ``"pierson_moskowitz"`` (Hs,
+      Tp): the spectrum cut into ``components`` waves evenly spaced in wave number over ``frequency_range``,
+      each carrying its share of the variance Hs^2 / 16, with random phases from ``seed``;
+    - ``"table"``: your own components, rows of amplitude [m], angular frequency [rad/s], phase [deg] and
+      direction [deg], inline as ``table`` or from ``table_file``, a CSV file whose header names those columns.
+
+    The surface is eta = sum a cos(k (x cos beta - z sin beta) - w t + phi): ``direction`` beta turns the
+    waves about the vertical from +x (MoorDyn's heading); in 2-D they travel along +x (0) or -x (180)."""
+
+    kind: str = spec("str", "regular, jonswap, pierson_moskowitz or table", choices=WAVE_KINDS)
+    height: float | None = spec("float", "regular: wave height H, crest to trough", "m", default=None,
+                                required=False, low=0, open_low=True)
+    period: float | None = spec("float", "regular: wave period T", "s", default=None, required=False, low=0,
+                                open_low=True)
+    phase: float = spec("float", "regular: phase phi, the surface eta = H/2 cos(k x - w t + phi)", "deg",
+                        default=0.0)
+    direction: float = spec("float", "the direction the waves travel, about the vertical from +x", "deg",
+                            default=0.0, low=-360.0, high=360.0)
+    significant_height: float | None = spec("float", "spectra: significant wave height Hs (4 times the surface's "
+                                                     "standard deviation)", "m", default=None, required=False,
+                                            low=0, open_low=True)
+    peak_period: float | None = spec("float", "spectra: peak period Tp", "s", default=None, required=False, low=0,
+                                     open_low=True)
+    gamma: float | None = spec("float", "jonswap: peak enhancement factor (default: DNV-RP-C205's from Tp / "
+                                        "sqrt(Hs))", default=None, required=False, low=1.0, high=20.0)
+    components: int | None = spec("int", "spectra: how many waves the spectrum is cut into", default=None,
+                                  required=False, low=1, high=5000)
+    seed: int = spec("int", "spectra: seed of the random phases", default=0, low=0)
+    frequency_range: tuple | None = spec("float_list", "spectra: lowest and highest angular frequency (default: "
+                                                       "0.5 and 3 times the peak's)", "rad/s", default=None,
+                                         required=False)
+    table: tuple | None = spec("wave_rows", "table: rows of amplitude, angular frequency, phase, direction",
+                               "m, rad/s, deg, deg", default=None, required=False)
+    table_file: str | None = spec("str", "table: CSV file with columns amplitude, frequency, phase, direction "
+                                         "(relative to the scene file's folder)", default=None, required=False)
+    stretching: str = spec("str", "how the kinematics reach the moving surface: wheeler, or vertical (the mean "
+                                  "level's held above it)", default="wheeler", choices=("wheeler", "vertical"))
+    ramp_time: float = spec("float", "time over which the waves grow from still water (0: at once)", "s",
+                            default=0.0, low=0)
+
+
+@dataclass(frozen=True)
 class Body:
     """A point body carried by one node (an end mass, a hook, a parachute): its mass joins the node's, and it
     adds buoyancy rho V g, quadratic drag -1/2 rho CdA |u| u on the velocity relative to the flow, and added
@@ -769,6 +841,8 @@ class Scene:
     buoyancy: Buoyancy | None = None
     added_mass: AddedMass | None = None
     seabed: Seabed | None = None
+    sea: Sea | None = None
+    waves: Waves | None = None
     bending: Bending | None = None
     thrower: Thrower | None = None
     guides: tuple[Guide, ...] = ()
@@ -813,6 +887,8 @@ TABLES = {
     "buoyancy": Buoyancy,
     "added_mass": AddedMass,
     "seabed": Seabed,
+    "sea": Sea,
+    "waves": Waves,
     "bending": Bending,
     "thrower": Thrower,
     "pinned": Pinned,

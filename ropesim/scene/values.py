@@ -103,6 +103,14 @@ def parse_value(value: Any, sp: S.Spec, key: str, source: str, dim: int):
         if not isinstance(value, list) or not value:
             bad(f"must be a list of points, each a list of {dim} numbers")
         return tuple(vector_of(p, dim, f"{key}[{i}]", source, sp) for i, p in enumerate(value))
+    if sp.kind == "wave_rows":
+        ok = isinstance(value, list) and value and all(isinstance(row, list) for row in value)
+        if not ok:
+            bad("must be a list of rows, each 4 finite numbers (amplitude, angular frequency, phase, direction)")
+        if len(value) > MAX_PATH_ROWS:
+            raise SceneError(source, key, f"must be at most {MAX_PATH_ROWS:,} rows, got {len(value):,}")
+        return tuple(numbers_of(row, 4, f"{key}[{i}]", source, sp, "amplitude, angular frequency, phase, direction")
+                     for i, row in enumerate(value))
     if sp.kind in ("rows", "dof_rows"):
         n, what = (dim, "one per axis") if sp.kind == "rows" else (count_of("dofs", dim), "one per degree of freedom")
         ok = isinstance(value, list) and value and all(

@@ -181,6 +181,39 @@ class Speed:
         return speed
 
 
+class WaveHeights:
+    """The sea's surface height [m] (F, len(x), len(z)) over a grid, computed from the scene's waves for the
+    frames read (:class:`ropesim.model.waves.WaveField`)."""
+
+    def __init__(self, field, t: np.ndarray, x: np.ndarray, z: np.ndarray):
+        self.field, self.t, self.x, self.z = field, t, x, z
+        self.shape = (len(t), len(x), len(z))
+        self.ndim = 3
+
+    def __getitem__(self, index):
+        t = np.asarray(self.t[index], dtype=float)
+        return self.field.level + self.field.elevation(self.x[None, :, None], t[..., None, None],
+                                                       self.z[None, None, :])
+
+
+def _water(scene, traj) -> Surface:
+    """The sea's surface: flat at its level, or in 3-D with waves a 33 x 33 grid over the run's extent and the
+    viewer's margin around it (0.6 of its size), moving frame by frame."""
+    from ..model.waves import wave_field
+
+    field = wave_field(scene)
+    if field is None or scene.dimension == 2:   # the 2-D view draws the mean level
+        return Surface(height=scene.sea.level)
+    frames = np.arange(0, len(traj.t), max(1, len(traj.t) // 100))   # the extent, from a hundred frames
+    x = np.asarray(traj.x[frames], dtype=float)
+    lo, hi = x.min(axis=(0, 1)), x.max(axis=(0, 1))
+    pad = 0.6 * float(np.max(hi - lo))
+    grid_x = np.linspace(lo[0] - pad, hi[0] + pad, 33)
+    grid_z = np.linspace(lo[2] - pad, hi[2] + pad, 33)
+    return Surface(height=scene.sea.level, x=grid_x, z=grid_z,
+                   heights=WaveHeights(field, np.asarray(traj.t, dtype=float), grid_x, grid_z))
+
+
 class Scaled:
     """``values`` times ``factor`` when read (strain as a percentage)."""
 
@@ -225,6 +258,8 @@ def run_content(run) -> RunContent:
                           for g in scene.guides)
     if scene.seabed is not None:
         content.seabed = Surface(height=scene.seabed.height, slope_deg=scene.seabed.slope)
+    if scene.sea is not None:
+        content.water = _water(scene, traj)
     content.series.extend(_series(traj, model))
     content.summary.extend(_summary(traj, content))
     return content

@@ -86,7 +86,7 @@ def _params(scene, layout) -> np.ndarray:
 
 
 def _active(scene) -> bool:
-    return (scene.flow is not None and scene.flow.ramp_time > 0.0
+    return (scene.flow is not None and scene.flow.ramp_time > 0.0 and scene.sea is None
             and (scene.buoyancy is not None or ADDED_MASS_TERM.declared(scene)))
 
 

@@ -168,6 +168,18 @@ def add_fluid_forces(x, v, acc, p, t):
 
 
 
+@jit.kernel(inline="always")
+def morison_damping(a, b, q, nv, speed_n, along, cn, ct):
+    """Entry (a, b) of the Morison drag's damping -dF/dv at a relative velocity of normal part ``nv`` (its
+    magnitude ``speed_n``) and tangential part ``along`` q, the tangent q frozen: c_n L (|u_n| P + u_n u_n^T /
+    |u_n|) + 2 c_t L |u . q| q q^T (P = I - q q^T); cn = c_n L, ct = c_t L."""
+    qq = q[a] * q[b]
+    c = cn * speed_n * ((1.0 if a == b else 0.0) - qq) + 2.0 * ct * abs(along) * qq
+    if speed_n > 0.0:
+        c += cn * nv[a] * nv[b] / speed_n
+    return c
+
+
 @jit.kernel
 def add_fluid_jacobian(x, v, band, beta, free, p, t):
     """Add beta C to the Newton matrix's node blocks (see :mod:`ropesim.model.jacobian`), C = -dF/dv the fluid
@@ -204,9 +216,7 @@ def add_fluid_jacobian(x, v, band, beta, free, p, t):
                 qq = q[a] * q[b]
                 c = 0.0
                 if WITH_FLUID_DRAG:
-                    c += c_n[i] * length * speed_n * (unit - qq) + 2.0 * c_t[i] * length * abs(along) * qq
-                    if speed_n > 0.0:
-                        c += c_n[i] * length * nv[a] * nv[b] / speed_n
+                    c += morison_damping(a, b, q, nv, speed_n, along, c_n[i] * length, c_t[i] * length)
                 if WITH_VISCOUS_DRAG:
                     c += length * (b_n * (unit - qq) + b_t * qq)
                 if speed > 0.0:
@@ -276,8 +286,8 @@ def _drag_by_tangent(j, k, q, u, a, un, sn, cn, ct, lin):
 
 def speed_scale(model) -> float:
     """A speed [m/s] the run's relative velocities stay near: twice the largest of the initial and held node
-    speeds, the flow's largest speed and the thrower's v_max (for the stability bound of velocity-dependent
-    drag, which grows with speed)."""
+    speeds, the flow's largest speed, the thrower's v_max, and with a sea the wind's speed and the waves' orbital
+    speed at the surface (for the stability bound of velocity-dependent drag, which grows with speed)."""
     scene = model.scene
     speeds = [float(np.abs(model.v0).max(initial=0.0)), float(np.abs(model.held_v).max(initial=0.0))]
     if scene.flow is not None:
@@ -285,6 +295,13 @@ def speed_scale(model) -> float:
         speeds.append(max(math.hypot(*row) for row in rows))
     if scene.thrower is not None:
         speeds.append(abs(scene.thrower.v_max))
+    if scene.sea is not None:
+        from ..waves import orbital_speed, wave_field
+
+        if scene.sea.wind is not None:
+            speeds.append(math.hypot(*scene.sea.wind))
+        if scene.waves is not None:
+            speeds.append(orbital_speed(wave_field(scene)))
     return 2.0 * max(speeds + [1.0])
 
 
