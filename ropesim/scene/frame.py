@@ -34,7 +34,7 @@ TURNS = {
     # vectors: positions, velocities, displacements, points in a body's frame, angular velocities
     "position": VECTOR, "velocity": VECTOR, "velocities": VECTOR, "amplitude": VECTOR, "path_table": VECTOR,
     "center_of_gravity": VECTOR, "center_of_buoyancy": VECTOR, "angular_velocity": VECTOR, "top": VECTOR,
-    "start": VECTOR, "end": VECTOR, "points": VECTOR, "top_center": VECTOR, "center": VECTOR,
+    "start": VECTOR, "end": VECTOR, "points": VECTOR, "top_center": VECTOR, "center": VECTOR, "wind": VECTOR,
     # one magnitude per axis (body axes or world axes): permuted
     "cd_area": AXES, "added_mass": AXES, "cd_rotation": AXES, "added_inertia": AXES, "stiffness": AXES,
     "damping": AXES, "period": AXES, "phase": AXES,
