@@ -10,7 +10,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import sys
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -95,27 +94,9 @@ ALL_CASES = [(name, method) for name in [p.stem for p in sorted(SCENARIOS.glob("
 CASES = [(name, method) for name, method in ALL_CASES if f"{name}__{method}" in RECORDED]
 
 
-def own_method(name: str) -> str:
-    """The method a case's scene declares (the loader's default, symplectic_euler, where it declares none)."""
-    raw = tomllib.loads((SCENARIOS / f"{name}.toml").read_text()) if (SCENARIOS / f"{name}.toml").exists() \
-        else EXTRA.get(name, {})
-    return raw.get("integrator", {}).get("method", "symplectic_euler")
-
-
-# The fast suite checks every scene under its own method and every method on the helicopter (each compiled loop
-# family on each kind of scene once, the terms' code in every family); the other 55 combinations, each a loop
-# compiled for that scene's terms and that family alone (the shooter's thrower under sdirk2 and rk4, a plain loop
-# under sdirk2), run in the slow suite, in CI. `python -m pytest tests/test_bit_identity.py -m ""` runs all 72.
-FAST_CASES = {(name, method) for name, method in CASES
-              if method == own_method("shooter_medium" if name == "shooter_medium_smooth" else name)
-              or name == "helicopter_mass"}
-
-
 def test_every_recorded_run_is_checked():
     assert sorted(f"{name}__{method}" for name, method in CASES) == sorted(RECORDED)
     assert len(CASES) == 72
-    assert {name for name, _ in FAST_CASES} == {name for name, _ in CASES}   # every scene and every method
-    assert {method for _, method in FAST_CASES} == set(METHODS)              # in the fast suite too
 
 
 @pytest.fixture(scope="module")
@@ -128,8 +109,7 @@ def index():
     return json.loads((DATA / "index.json").read_text())
 
 
-@pytest.mark.parametrize("name,method", [pytest.param(n, m, marks=[] if (n, m) in FAST_CASES else [pytest.mark.slow])
-                                         for n, m in CASES], ids=[f"{n}-{m}" for n, m in CASES])
+@pytest.mark.parametrize("name,method", CASES, ids=[f"{n}-{m}" for n, m in CASES])
 def test_reproduces_recorded_run_bit_for_bit(all_scenes, index, name, method):
     key = f"{name}__{method}"
     got = run_case(with_method(all_scenes[name], method))
