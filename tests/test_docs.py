@@ -274,8 +274,11 @@ def test_cli_reference_places_new_commands(monkeypatch):
 
 @pytest.fixture(scope="module")
 def site(tmp_path_factory) -> Path:
-    """The site built by `mkdocs build --strict` into a temporary folder (skipped without the docs extra)."""
+    """The site built by `mkdocs build --strict` into a temporary folder: CI's build of the site (`.ci/run` sets
+    ROPESIM_REQUIRE_DOCS=1, which turns the skip without the docs extra into a failure, and builds it nowhere else)."""
     if importlib.util.find_spec("mkdocs") is None or importlib.util.find_spec("mkdocstrings") is None:
+        if os.environ.get("ROPESIM_REQUIRE_DOCS") == "1":
+            pytest.fail("ROPESIM_REQUIRE_DOCS=1 but the docs extra is not installed", pytrace=False)
         pytest.skip('the docs extra is not installed (pip install -e ".[docs]")')
     out = tmp_path_factory.mktemp("site")
     env = {**os.environ, "NO_MKDOCS_2_WARNING": "1"}
