@@ -163,7 +163,8 @@ def main() -> None:
                         results[kind].setdefault(name, {}).setdefault(who, []).append(m)
                         print(f"round {r + 1} {who:>10} {kind:<10} {name:<22} cold {m['cold']['cpu']:6.1f} s CPU "
                               f"({m['cold']['wall']:6.1f} s wall), warm {m['warm']['cpu']:5.2f} s CPU", flush=True)
-            results["warm_process"] = warm_process(args.warm_rounds, work)
+            if args.warm_rounds > 0:
+                results["warm_process"] = warm_process(args.warm_rounds, work)
         finally:
             if args.against:
                 subprocess.run(["git", "worktree", "remove", "--force", str(trees[args.against])], cwd=ROOT,
@@ -199,7 +200,9 @@ def report(results: dict, trees: list[str], against: str | None) -> None:
                 row.append(f"{med(by['this'], 'cold', 'cpu') / med(by[against], 'cold', 'cpu'):.2f}")
             table.add_row(*row)
         console.print(table)
-    warm = results["warm_process"]
+    warm = results.get("warm_process")
+    if warm is None:
+        return
     table = Table(title=f"Warm whole process, helicopter_uniform: {len(warm['rounds'])} paired rounds, medians")
     for col in ("process", "wall [s]", "CPU [s]"):
         table.add_column(col, justify="left" if col == "process" else "right")
