@@ -14,7 +14,7 @@ import tomli_w
 
 import ropesim
 from ropesim.analysis.statics import equilibrium
-from ropesim.model.forces.fluid import ramp
+from ropesim.model.ramp import ramp
 
 
 def pinned_line(law: str, current=(1.0, 0.0), ramp_time: float = 0.0) -> ropesim.Scene:

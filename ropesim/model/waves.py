@@ -59,8 +59,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import jit
-from .forces.fluid import ramp
-from .forces.flow_inertia import ramp_rate
+from .ramp import ramp, ramp_rate
 
 BREAKING_STEEPNESS = 1.0 / 7.0   # H / L above which a wave breaks (Michell 1893; DNV-RP-C205 3.4.6)
 JONSWAP_SIGMA = (0.07, 0.09)     # the peak's width below and above w_p (DNV-RP-C205 3.5.5)

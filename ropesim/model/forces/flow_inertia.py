@@ -24,7 +24,6 @@ node, zero for held nodes.
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
@@ -34,16 +33,9 @@ from .added_mass import _params as added_mass_params
 from .buoyancy import displaced_volume
 from .fluid import flow_scaled, node_tangent
 from .. import jit
+from ..ramp import ramp_rate
 
 WITH_FLOW_INERTIA = jit.Switch("flow_inertia", "the accelerating water's inertia force")
-
-
-@jit.kernel
-def ramp_rate(t, ramp_time):
-    """The rate r'(t) [1/s] of the flow's ramp r(t) = (1 - cos(pi t / T)) / 2 (0 before 0 and after T)."""
-    if ramp_time <= 0.0 or t <= 0.0 or t >= ramp_time:
-        return 0.0
-    return 0.5 * math.pi / ramp_time * math.sin(math.pi * t / ramp_time)
 
 
 @jit.kernel

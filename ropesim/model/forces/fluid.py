@@ -33,6 +33,7 @@ import numpy as np
 from . import Term
 from ..layout import lumped_bodies, per_node
 from .. import jit
+from ..ramp import ramp
 
 WITH_FLUID_DRAG = jit.Switch("fluid_drag", "Morison quadratic drag")
 WITH_VISCOUS_DRAG = jit.Switch("viscous_drag", "linear anisotropic drag")
@@ -42,16 +43,6 @@ WITH_FLOW_PUSH = jit.Switch("flow_push", "a flow's push on the linear drag")
 UNIFORM, POWER_LAW, TABLE = 0, 1, 2
 PROFILES = {"uniform": UNIFORM, "power_law": POWER_LAW, "table": TABLE}
 FLOW_PARAMS = 8
-
-
-@jit.kernel
-def ramp(t, ramp_time):
-    """The flow's ramp factor at time t [s]: (1 - cos(pi t / T)) / 2 until T, then 1."""
-    if ramp_time <= 0.0 or t >= ramp_time:
-        return 1.0
-    if t <= 0.0:
-        return 0.0
-    return 0.5 * (1.0 - math.cos(math.pi * t / ramp_time))
 
 
 @jit.kernel

@@ -62,7 +62,7 @@ from . import Term
 from .added_mass import ADDED_MASS_TERM, WITH_ADDED_MASS
 from .fluid import (WITH_BODY_DRAG, WITH_FLOW, WITH_FLUID_DRAG, flow_at, flow_scaled, morison_damping,
                     node_tangent)
-from .flow_inertia import ramp_rate
+from ..ramp import ramp_rate
 from ..junctions import WITH_JUNCTIONS
 from ..layout import junctions, line_volumes, lumped_bodies, per_node
 from ..waves import (COMP_ROWS, LEVEL, NODE_ROWS, WAVE_SCALARS, compiled_tables, node_kinematics, wave_field)
