@@ -12,9 +12,10 @@ ropesim by changing its import::
 Every array is in MoorDyn's frame and units: z up, SI, angles in radians. The scene is read by
 :func:`ropesim.load_scene`: a ropesim scene, or a MoorDyn v2 input file as ``ropesim run`` reads it; its coupled
 points and bodies (``kind = "coupled"``, MoorDyn's Coupled and Vessel objects) are the coupled degrees of
-freedom, bodies first, then points, each in the scene's order, as MoorDyn orders them. A y-up scene's
-coordinates are turned: MoorDyn's (x, y, z) is the scene's (x, z, -y). Calls run through
-:class:`ropesim.Coupling`, whose documentation says what a coupling step does.
+freedom, bodies first, then points, each in the scene's order, as MoorDyn orders them. A MoorDyn file reads
+as a z-up scene (``up = "z"``), whose frame is MoorDyn's: nothing is turned here. A y-up scene's coordinates are
+turned: MoorDyn's (x, y, z) is the scene's (x, z, -y). Calls run through :class:`ropesim.Coupling`, whose
+documentation says what a coupling step does.
 
 A coupled body's angles are MoorDyn's (roll, pitch, yaw, R = Rx Ry Rz, ``Euler2Quat``) and its angular
 velocity the world-axes one MoorDyn moves its points with; both are turned into the scene's angles (R = Rz Ry
@@ -42,7 +43,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..coupling import Coupling, CouplingError
+from ..coupling import Coupling, CouplingError, angle_rates, angles_of
+from ..scene.frame import P, frame_of
 
 __all__ = ["Create", "NCoupledDOF", "Init", "Init_NoIC", "Step", "Close", "GetNumberLines", "GetNumberPoints",
            "GetNumberBodies", "GetLine", "GetPoint", "GetBody", "GetLineID", "GetPointID", "GetBodyID",
@@ -61,9 +63,11 @@ class System:
             raise CouplingError(f"{scene.name}: MoorDyn's calls move 3-D systems; this scene is 2-D")
         self.coupling = Coupling(scene)
         self.scene = scene
-        # P turns MoorDyn's (z-up) coordinates into the coupling's, ropesim's y-up frame, (x, y, z) -> (x, z, -y),
-        # whatever the scene's up: a z-up scene (up = "z") computes, and is coupled, in its y-up twin
-        self.turn = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])
+        # turn: MoorDyn's coordinates -> the scene's, whose frame the coupling takes: nothing for a z-up scene
+        # (up = "z", as a MoorDyn file reads), P: (x, y, z) -> (x, z, -y) for a y-up one. inside: MoorDyn's ->
+        # the model's own arrays, always its y-up twin's (the getters read them)
+        self.turn = np.eye(3) if frame_of(scene).turned else P
+        self.inside = P
         self.last_x = self.last_v = None
         self.forces = None
 
@@ -82,14 +86,14 @@ class System:
             raise CouplingError(f"{self.scene.name}: x and xd need {c.dofs} numbers each (NCoupledDOF), got "
                                 f"{x.size} and {v.size}")
         out_x, out_v = np.empty(c.dofs), np.empty(c.dofs)
-        P = self.turn
+        turn = self.turn
         for o in c.objects:
             s = o.first
-            out_x[s:s + 3], out_v[s:s + 3] = P @ x[s:s + 3], P @ v[s:s + 3]
+            out_x[s:s + 3], out_v[s:s + 3] = turn @ x[s:s + 3], turn @ v[s:s + 3]
             if o.kind == "body":
-                angles = scene_angles(P @ moordyn_rotation(*x[s + 3:s + 6]) @ P.T)
+                angles = angles_of(turn @ moordyn_rotation(*x[s + 3:s + 6]) @ turn.T)
                 out_x[s + 3:s + 6] = angles
-                out_v[s + 3:s + 6] = angle_rates(angles, P @ v[s + 3:s + 6])
+                out_v[s + 3:s + 6] = angle_rates(angles, turn @ v[s + 3:s + 6])
         return out_x, out_v
 
     def to_moordyn(self, forces: np.ndarray) -> list[float]:
@@ -101,8 +105,9 @@ class System:
                 out[start:start + 3] = back @ forces[start:start + 3]
         return out.tolist()
 
-    def vector(self, scene_vector) -> list[float]:
-        return (self.turn.T @ np.asarray(scene_vector, dtype=float)).tolist()
+    def vector(self, inside_vector) -> list[float]:
+        """A vector of the model's own arrays (the y-up twin's) in MoorDyn's frame."""
+        return (self.inside.T @ np.asarray(inside_vector, dtype=float)).tolist()
 
     # -- state now ------------------------------------------------------------------------------------------
 
@@ -126,21 +131,6 @@ def moordyn_rotation(roll: float, pitch: float, yaw: float) -> np.ndarray:
     ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
     rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
     return rx @ ry @ rz
-
-
-def scene_angles(R: np.ndarray) -> np.ndarray:
-    """The scene's angles (about x, then y, then z: R = Rz(c) Ry(b) Rx(a)) of rotation matrix R [rad]."""
-    b = -math.asin(max(-1.0, min(1.0, R[2, 0])))
-    return np.array([math.atan2(R[2, 1], R[2, 2]), b, math.atan2(R[1, 0], R[0, 0])])
-
-
-def angle_rates(angles: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """The rates of the scene's angles (a, b, c) that turn a body at angular velocity w (world axes):
-    w = a' u3 + b' u2 + c' e_z, u2 = Rz(c) e_y, u3 = Rz(c) Ry(b) e_x (:func:`ropesim.model.motion.rigid_state`)."""
-    _, b, c = angles
-    u3 = [math.cos(c) * math.cos(b), math.sin(c) * math.cos(b), -math.sin(b)]
-    u2 = [-math.sin(c), math.cos(c), 0.0]
-    return np.linalg.solve(np.array([u3, u2, [0.0, 0.0, 1.0]]).T, w)
 
 
 @dataclass(frozen=True)
@@ -351,7 +341,7 @@ def GetFASTtens(instance: System, n_lines: int):
     out = ([], [], [], [])
     for layout in instance.model.lines[:int(n_lines)]:
         for k, node in ((0, layout.end - 1), (2, layout.first)):
-            f = instance.turn.T @ forces[:, node]
+            f = instance.inside.T @ forces[:, node]
             out[k].append(float(math.hypot(f[0], f[1])))
             out[k + 1].append(float(f[2]))
     return out
