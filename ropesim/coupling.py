@@ -369,8 +369,9 @@ class Coupling:
         bad = np.flatnonzero(~np.isfinite(a.ravel()))
         if bad.size:
             k = int(bad[0]) // (shape[1] if len(shape) > 1 else 1)
-            raise CouplingError(f"{self.scene.name}: set_waves: {what} at node {k} is {a.ravel()[bad[0]]!r}; every "
-                                f"value must be a finite number")
+            value = float(a.ravel()[bad[0]])
+            raise CouplingError(f"{self.scene.name}: set_waves: {what} at node {k} is {value!r}; every value must be a "
+                                f"finite number")
         return a
 
     # -- state ---------------------------------------------------------------------------------------------
