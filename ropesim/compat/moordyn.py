@@ -25,7 +25,9 @@ angles do, two paths that agree to second order in the rotation over one couplin
 Not supported, one line each (a call raises :class:`NotImplementedError` saying so):
 
 - rods (``GetRod`` and every rod getter): ropesim has no rods;
-- external wave kinematics (``ExternalWaveKinInit``, ``ExternalWaveKinSet``, ``GetWaves``): ropesim has no sea state yet;
+- ``GetWaves`` (MoorDyn's wave object): the waves are given (``ExternalWaveKinSet``) or the scene's own ``[waves]``;
+- external wave kinematics give no surface elevation (MoorDyn's calls have none): the surface stays flat at the
+  sea's level, and a point's own entry is not used (its line ends' entries, at the same place, are);
 - ``GetSeafloor`` (a bathymetry file): ropesim's seabed is flat;
 - ``Log`` and ``SetVerbosity`` are accepted and do nothing: ropesim writes no log file;
 - ``Serialize`` / ``Deserialize`` (bytes in MoorDyn's format): use ``SaveState`` / ``LoadState`` (ropesim's own file, a NumPy .npz);
@@ -50,7 +52,9 @@ __all__ = ["Create", "NCoupledDOF", "Init", "Init_NoIC", "Step", "Close", "GetNu
            "GetNumberBodies", "GetLine", "GetPoint", "GetBody", "GetLineID", "GetPointID", "GetBodyID",
            "GetLineN", "GetLineNumberNodes", "GetLineUnstretchedLength", "GetLineNodePos", "GetLineNodeTen",
            "GetLineFairTen", "GetFASTtens", "GetPointPos", "GetPointVel", "GetPointForce", "GetPointNAttached",
-           "GetBodyState", "GetBodyForce", "SaveState", "LoadState", "Log", "SetVerbosity", "MoorDynError"]
+           "GetBodyState", "GetBodyForce", "SaveState", "LoadState", "Log", "SetVerbosity", "ExternalWaveKinInit",
+           "ExternalWaveKinGetN", "ExternalWaveKinGetCoordinates", "GetWaveKinCoordinates", "ExternalWaveKinSet",
+           "SetWaveKin", "MoorDynError"]
 
 MoorDynError = CouplingError
 
@@ -224,13 +228,77 @@ def _unsupported(name: str, why: str):
 
 GetRod = _unsupported("GetRod", "ropesim has no rods")
 GetNumberRods = lambda instance: 0  # noqa: E731  (a system without rods)
-ExternalWaveKinInit = _unsupported("ExternalWaveKinInit", "ropesim has no sea state yet")
-ExternalWaveKinSet = _unsupported("ExternalWaveKinSet", "ropesim has no sea state yet")
-GetWaves = _unsupported("GetWaves", "ropesim has no sea state yet")
+GetWaves = _unsupported("GetWaves", "the waves are given (ExternalWaveKinSet) or the scene's own [waves]")
 GetSeafloor = _unsupported("GetSeafloor", "ropesim's seabed is flat (no bathymetry file)")
 Serialize = _unsupported("Serialize", "use SaveState (ropesim's own .npz file)")
 Deserialize = _unsupported("Deserialize", "use LoadState (ropesim's own .npz file)")
 GetLineNodeCurv = _unsupported("GetLineNodeCurv", "ropesim does not report curvature")
+
+
+# -- external wave kinematics (MoorDyn's WaveKin = 1) ---------------------------------------------------------
+
+
+def _wave_nodes(instance: System) -> np.ndarray:
+    """The model's node of each of MoorDyn's wave points: every line's nodes from its start (node 0) to its end,
+    line by line, then each point's first line end (MoorDyn's Waves::getWaveKinematicsPoints order)."""
+    from ..model.layout import point_ends
+
+    nodes = [node for layout in instance.model.lines for node in range(layout.first, layout.end)]
+    ends = point_ends(instance.scene, instance.model.lines)
+    return np.array(nodes + [ends[p.id][0] for p in instance.scene.points], dtype=np.int64)
+
+
+def ExternalWaveKinInit(instance: System) -> int:
+    """The number of points where the waves' kinematics are wanted (call after :func:`Init`); the scene needs a
+    ``[sea]`` (a MoorDyn file with WaveKin = 1 imports with one)."""
+    instance.coupling.wave_points()       # refuses a scene without a sea in one line
+    instance.wave_nodes = _wave_nodes(instance)
+    return len(instance.wave_nodes)
+
+
+def ExternalWaveKinGetN(instance: System) -> int:
+    return len(getattr(instance, "wave_nodes", ()))
+
+
+def ExternalWaveKinGetCoordinates(instance: System) -> list[list[float]]:
+    """The points (n, 3) where :func:`ExternalWaveKinSet` wants the waves, now (MoorDyn's frame)."""
+    x, _ = instance.state()
+    nodes = _need_wave_init(instance, "ExternalWaveKinGetCoordinates")
+    return (instance.inside.T @ x[:, nodes]).T.tolist()
+
+
+GetWaveKinCoordinates = ExternalWaveKinGetCoordinates
+
+
+def ExternalWaveKinSet(instance: System, u, a, t: float = 0.0) -> int:
+    """The waves' velocity ``u`` and acceleration ``a`` (n, 3 each, MoorDyn's frame) at the points of
+    :func:`ExternalWaveKinGetCoordinates`, used until they are set again (t is not read, as MoorDyn does not);
+    0."""
+    nodes = _need_wave_init(instance, "ExternalWaveKinSet")
+    n = len(nodes)
+    on_lines = nodes[:n - len(instance.scene.points)]
+    values = []
+    for what, given in (("u", u), ("a", a)):
+        try:
+            array = np.array(given, dtype=float).reshape(n, 3)
+        except (TypeError, ValueError):
+            raise CouplingError(f"{instance.scene.name}: ExternalWaveKinSet: {what} needs {n} x 3 numbers (one row "
+                                f"per point of ExternalWaveKinGetCoordinates), got {np.size(given)}") from None
+        per_node = np.zeros((instance.model.nodes, 3))
+        per_node[on_lines] = array[:len(on_lines)] @ instance.turn.T     # the scene's frame
+        values.append(per_node)
+    instance.coupling.set_waves(*values)
+    return 0
+
+
+SetWaveKin = ExternalWaveKinSet
+
+
+def _need_wave_init(instance: System, call: str) -> np.ndarray:
+    nodes = getattr(instance, "wave_nodes", None)
+    if nodes is None:
+        raise CouplingError(f"{instance.scene.name}: {call} before ExternalWaveKinInit; call it once after Init")
+    return nodes
 
 
 # -- lines, points, bodies ----------------------------------------------------------------------------------
