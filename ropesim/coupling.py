@@ -54,6 +54,7 @@ from pathlib import Path
 import numpy as np
 
 from .integrate.grid import TimeGrid
+from .integrate.base import SCHEDULE_AT, Schedule
 from .integrate.health import E0, OK
 from .model.build import Model, build
 from .model.jit import Direct
@@ -191,7 +192,7 @@ class Coupling:
         self.integrator = None
         self.writer = None
         self._rows = None
-        self._begin_step = self._end = self._held = self._no_frames = None
+        self._begin_step = self._end = self._held = self._quiet = None
         self._objects = objects_bundle(self.objects, self.model.dim)
         self._acc = np.zeros((self.model.dim, self.model.nodes))
         self._last_acc = self._acc       # the accelerations the last forces came from
@@ -551,7 +552,9 @@ class Coupling:
             from .model.coupled import begin_step
 
             self._begin_step = Direct(self.model.kernel(begin_step))
-        bad = self._begin_step.fast(float(t0), x, v, self._objects, held, state_x, state_v)
+        elif type(self._begin_step) is Direct and self._begin_step.entry is not None:
+            self._begin_step = self._begin_step.entry      # its compiled copy itself from now on
+        bad = self._begin_step(float(t0), x, v, self._objects, held, state_x, state_v)
         if bad >= 0:     # nothing was moved
             self._refuse(bad, x, v)
 
@@ -580,7 +583,7 @@ class Coupling:
         save_every = max(1, round(scene.output.interval / h))
         grid = TimeGrid(dt=h, steps=UNBOUNDED_STEPS, save_every=save_every, requested_dt=scene.integrator.dt)
         self.integrator = make_integrator(self.model, grid)
-        self._no_frames = None
+        self._quiet = None
         self.integrator.warm_up()
         self.integrator.loop = Direct(self.integrator.loop)   # its arguments keep their types: no dispatch
         self._loop_acc = self.integrator.last_accelerations
@@ -619,13 +622,18 @@ class Coupling:
         i = self.integrator
         tick = time.perf_counter()
         self._begin(i.step * i.grid.dt, x, v, i.held, i.x, i.v)
-        if i.frames_in(n):
+        save_every = i.grid.save_every      # a coupling's grid has no end: frames are due at multiples of it
+        if (i.step + n) // save_every != i.step // save_every:
             frames = i.new_frames(n)
-        else:                               # most coupling steps save no frame: the same empty buffers
-            if self._no_frames is None:
-                self._no_frames = i.new_frames(0)
-            frames = self._no_frames
-        done, written, status, node = i._run(n, frames)     # Integrator.advance, without its bundling
+            done, written, status, node = i._run(n, frames)     # Integrator.advance, without its bundling
+        else:    # most coupling steps save no frame: the loop's arguments are kept, but for the Schedule
+            quiet = self._quiet
+            if quiet is None or quiet[2] != n:
+                args = list(i.loop_args(n, i.new_frames(0)))
+                quiet = self._quiet = (args, tuple(args[SCHEDULE_AT])[2:], n)
+            args, rest, _ = quiet
+            args[SCHEDULE_AT] = Schedule(i.step, n, *rest)
+            done, written, status, node = i.loop(*args)
         if type(i.loop) is Direct:          # after its first call the loop is its compiled copy itself
             i.loop = i.loop.fast
         i.step += done
@@ -666,8 +674,10 @@ class Coupling:
             from .model.coupled import held_forces
 
             self._held = Direct(self.model.kernel(held_forces))
+        elif type(self._held) is Direct and self._held.entry is not None:
+            self._held = self._held.entry
         out = np.zeros(self.dofs)
-        self._held.fast(i.x, self._loop_acc, i.step * i.grid.dt, self.model.mass, self._objects, *self._held_args,
+        self._held(i.x, self._loop_acc, i.step * i.grid.dt, self.model.mass, self._objects, *self._held_args,
                         out)
         self._last_acc = self._loop_acc
         return out
