@@ -26,8 +26,7 @@ Not supported, one line each (a call raises :class:`NotImplementedError` saying 
 
 - rods (``GetRod`` and every rod getter): ropesim has no rods;
 - ``GetWaves`` (MoorDyn's wave object): the waves are given (``ExternalWaveKinSet``) or the scene's own ``[waves]``;
-- external wave kinematics give no surface elevation (MoorDyn's calls have none): the surface stays flat at the
-  sea's level, and a point's own entry is not used (its line ends' entries, at the same place, are);
+- a surface elevation with external wave kinematics (MoorDyn's calls give none: the surface stays at the sea's level), and a point's own entry (its line ends' are used);
 - ``GetSeafloor`` (a bathymetry file): ropesim's seabed is flat;
 - ``Log`` and ``SetVerbosity`` are accepted and do nothing: ropesim writes no log file;
 - ``Serialize`` / ``Deserialize`` (bytes in MoorDyn's format): use ``SaveState`` / ``LoadState`` (ropesim's own file, a NumPy .npz);
