@@ -10,12 +10,16 @@ as MoorDyn reports its last evaluation's), from an evaluation at the end state o
 its pose is its reference point and its angles about x, then y, then z (R = Rz Ry Rx), and the caller gives the
 angles' rates with its velocity.
 
-Degrees of freedom, in ropesim's y-up frame (a z-up scene, ``up = "z"``, is coupled in its y-up twin's frame,
-(x, y, z) -> (x, z, -y): turn its coordinates so, as :mod:`ropesim.compat.moordyn` does) and in the scene's order of ``[[bodies]]`` then ``[[points]]`` (MoorDyn
-too lists coupled bodies before coupled points): a coupled body has 6 in 3-D (x, y, z [m], then the angles
-about x, y, z [rad]) and 3 in 2-D (x, y, the angle about z); a coupled point has one per axis. The forces come
-in the same layout: a body's force [N] on its reference point and the moment [N m] about it (world axes), a
-point's force [N].
+Degrees of freedom, in the scene's own frame (y up, or z up for a scene with ``up = "z"``, as MoorDyn's) and in
+the scene's order of ``[[bodies]]`` then ``[[points]]`` (MoorDyn too lists coupled bodies before coupled points):
+a coupled body has 6 in 3-D (x, y, z [m], then the angles about x, y, z [rad], R = Rz Ry Rx in the scene's axes)
+and 3 in 2-D (x, y, the angle about z); a coupled point has one per axis. The forces come in the same layout: a
+body's force [N] on its reference point and the moment [N m] about it (world axes), a point's force [N]. A z-up
+scene computes in its y-up twin (:mod:`ropesim.scene.frame`): each call turns the positions and velocities into
+the twin, (x, y, z) -> (x, z, -y), a body's angles through its rotation, P R P^T, and their rates through the
+angular velocity they give (w = c' e_z + b' u2 + a' u3, turned by P, then the twin's rates), and the forces and
+moments back; every turn is exact up to round-off, so a z-up scene and its y-up twin coupled with the same motion
+give the same forces up to the axis permutation.
 
 The force on a coupled point is the net force on its line ends' nodes without their inertia, what MoorDyn
 reports for a coupled point (``Point::getFnet``): the lines' pull and the weight, buoyancy, drag and seabed push
@@ -25,6 +29,14 @@ model adds its own mass, buoyancy and drag (a coupled body has none in ropesim).
 The internal step is the scene's ``integrator.dt``; the first coupling step shrinks it, as MoorDyn shrinks dtM,
 to dt / ceil(dt / integrator.dt) when dt is not a whole number of it, and every later coupling step must be a
 whole number of internal steps. Time starts at 0 at :meth:`Coupling.init`.
+
+**Water kinematics from outside** (MoorDyn's external wave kinematics, ``WaveKin = 1``): a scene with a ``[sea]``
+may take the waves from the coupled program. It asks where they are wanted, :meth:`Coupling.wave_points` (every
+node, now), and gives the water's velocity and acceleration there (and, if it has one, the surface's elevation),
+:meth:`Coupling.set_waves`; every force evaluation uses them, held, until it gives them again (MoorDyn's rule too).
+They replace the scene's own ``[waves]`` from then on; a ``[flow]`` current is added on top. Held over a coupling
+step, they lag the waves they sample by up to a step: the run differs from one with the same waves inside ropesim
+at first order in the coupling step.
 
 With a ``folder`` the run is recorded as an ordinary run folder (frames every ``output.interval``, checkpoints
 by :meth:`Coupling.checkpoint`, finished by :meth:`Coupling.close`), which every command reads; a coupling
@@ -42,9 +54,11 @@ from pathlib import Path
 import numpy as np
 
 from .integrate.grid import TimeGrid
+from .integrate.base import SCHEDULE_AT, Schedule
 from .integrate.health import E0, OK
 from .model.build import Model, build
 from .model.jit import Direct
+from .scene.frame import P, frame_of
 
 BODY_ROWS = {3: (0, 1, 2, 3, 4, 5), 2: (0, 1, 5)}   # a body's degrees of freedom among a driven body's six rows
 STEP_TOLERANCE = 1e-9                              # relative: a coupling step is a whole number of internal steps
@@ -108,6 +122,41 @@ def objects_bundle(objects: tuple[CoupledObject, ...], dim: int):
                    np.array(BODY_ROWS[dim], dtype=np.int64))
 
 
+def rotation_of(angles) -> np.ndarray:
+    """The rotation R = Rz(c) Ry(b) Rx(a) of angles (a, b, c) [rad] about x, then y, then z."""
+    a, b, c = (float(q) for q in angles)
+    ca, sa, cb, sb, cc, sc = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(c), math.sin(c)
+    return np.array([[cc * cb, cc * sb * sa - sc * ca, cc * sb * ca + sc * sa],
+                     [sc * cb, sc * sb * sa + cc * ca, sc * sb * ca - cc * sa],
+                     [-sb, cb * sa, cb * ca]])
+
+
+def angles_of(R: np.ndarray) -> np.ndarray:
+    """The angles (a, b, c) [rad] of rotation matrix R = Rz(c) Ry(b) Rx(a), b in [-pi/2, pi/2]."""
+    b = -math.asin(max(-1.0, min(1.0, R[2, 0])))
+    return np.array([math.atan2(R[2, 1], R[2, 2]), b, math.atan2(R[1, 0], R[0, 0])])
+
+
+def _rate_axes(angles) -> np.ndarray:
+    """The columns u3 = Rz(c) Ry(b) e_x, u2 = Rz(c) e_y, e_z: w = (u3 u2 e_z) (a', b', c')."""
+    _, b, c = angles
+    return np.array([[math.cos(c) * math.cos(b), -math.sin(c), 0.0],
+                     [math.sin(c) * math.cos(b), math.cos(c), 0.0],
+                     [-math.sin(b), 0.0, 1.0]])
+
+
+def angular_velocity(angles, rates) -> np.ndarray:
+    """The angular velocity (world axes) [rad/s] of a body whose angles (a, b, c) change at ``rates``
+    (:func:`ropesim.model.motion.rigid_state`)."""
+    return _rate_axes(angles) @ np.asarray(rates, dtype=float)
+
+
+def angle_rates(angles, w) -> np.ndarray:
+    """The rates of the angles (a, b, c) that turn a body at angular velocity w (world axes); the inverse of
+    :func:`angular_velocity` (singular at b = +-pi/2)."""
+    return np.linalg.solve(_rate_axes(angles), np.asarray(w, dtype=float))
+
+
 class Coupling:
     """A system advanced one coupling step at a time by another program (see the module doc).
 
@@ -138,11 +187,12 @@ class Coupling:
             raise CouplingError(f"{scene.name}: no point or body has kind = 'coupled', so there is nothing for the "
                                 f"coupled program to move; give the points or bodies it moves kind = 'coupled'")
         self.dofs = sum(o.dofs for o in self.objects)
+        self.frame = frame_of(scene)     # the caller's frame; the model computes in the y-up twin
         self.folder = None if folder is None else Path(folder)
         self.integrator = None
         self.writer = None
         self._rows = None
-        self._begin_step = self._end = self._held = self._no_frames = None
+        self._begin_step = self._end = self._held = self._quiet = None
         self._objects = objects_bundle(self.objects, self.model.dim)
         self._acc = np.zeros((self.model.dim, self.model.nodes))
         self._last_acc = self._acc       # the accelerations the last forces came from
@@ -163,18 +213,23 @@ class Coupling:
         return self.scene.integrator.dt if self.integrator is None else self.integrator.grid.dt
 
     def positions(self) -> np.ndarray:
-        """The coupled objects' positions as the scene places them (the layout of :meth:`step`'s arrays)."""
+        """The coupled objects' positions as the scene places them (the layout of :meth:`step`'s arrays, the
+        scene's own frame)."""
         out = np.zeros(self.dofs)
         points = {p.id: p for p in self.scene.points}
         bodies = {b.id: b for b in self.scene.rigid_bodies}
-        dim = self.model.dim
+        given = dict(zip((b.id for b in self.scene.rigid_bodies), self.scene.given_orientations))
+        dim, frame = self.model.dim, self.frame
         for o in self.objects:
             if o.kind == "point":
-                out[o.part] = points[o.id].position
+                out[o.part] = frame.out(np.array(points[o.id].position))
             else:
                 body = bodies[o.id]
-                out[o.first:o.first + dim] = body.position
-                out[o.first + dim:o.first + o.dofs] = np.radians(body.orientation)
+                out[o.first:o.first + dim] = frame.out(np.array(body.position))
+                angles = given.get(o.id) if frame.turned else None
+                if angles is None and frame.turned:
+                    angles = np.degrees(angles_of(P.T @ rotation_of(np.radians(body.orientation)) @ P))
+                out[o.first + dim:o.first + o.dofs] = np.radians(body.orientation if angles is None else angles)
         return out
 
     def init(self, positions=None, velocities=None, *, statics: bool = True) -> np.ndarray:
@@ -185,6 +240,7 @@ class Coupling:
             raise CouplingError(f"{self.scene.name}: init() was called already; make a new Coupling to start again")
         x = self._checked(self.positions() if positions is None else positions, "positions")
         v = self._checked(np.zeros(self.dofs) if velocities is None else velocities, "velocities")
+        x, v = self._into(x, v)
         from .model.motion import Held
 
         model = self.model
@@ -193,7 +249,7 @@ class Coupling:
         if statics:
             self._solve_statics()
         self._start(self.scene.integrator.dt)
-        return self._end_forces()
+        return self._out(self._end_forces())
 
     def step(self, t: float, dt: float, positions, velocities) -> np.ndarray:
         """One coupling step from time ``t`` (the coupling's own time, :attr:`t`) to t + ``dt``, with the coupled
@@ -216,8 +272,11 @@ class Coupling:
         if not on_time:
             raise CouplingError(f"{self.scene.name}: step: t = {t!r} s, but the coupling stands at t = {now!r} s; "
                                 f"each step starts where the last one ended (the first at t = 0)")
-        return self._advance(self._step_n, self._checked(positions, "positions"),
-                             self._checked(velocities, "velocities"))
+        x, v = self._checked(positions, "positions"), self._checked(velocities, "velocities")
+        if self.frame.turned:
+            x, v = self._into(x, v)
+            return self._out(self._advance(self._step_n, x, v))
+        return self._advance(self._step_n, x, v)
 
     def mass(self) -> np.ndarray:
         """The mass matrix (dofs, dofs) [kg, kg m, kg m^2] of what the coupled objects carry now: their line ends'
@@ -254,14 +313,72 @@ class Coupling:
                 block[:3, 3:] -= mi @ cross
                 block[3:, :3] += cross @ mi
                 block[3:, 3:] -= cross @ mi @ cross
+            if self.frame.turned:     # the twin's block in the scene's frame: T^T M T, T = diag(P, P)
+                turn = np.kron(np.eye(2), P)
+                block = turn.T @ block @ turn
             keep = list(range(dim)) + ([3, 4, 5] if dim == 3 else [5]) if o.kind == "body" else list(range(dim))
             out[o.part, o.part] = block[np.ix_(keep, keep)]
         return out
 
+    # -- water kinematics from outside ---------------------------------------------------------------------
+
+    def _has_sea(self) -> bool:
+        return self.model.params.sea.nodes.shape[1] > 0
+
+    def wave_points(self) -> np.ndarray:
+        """Where :meth:`set_waves` wants the water's kinematics: every node's position now (N, D) [m], in the
+        scene's frame and the model's node order (each line's nodes from its start to its end, the lines in the
+        scene's order)."""
+        self._need_sea("wave_points")
+        x = self.model.x0 if self.integrator is None else self.integrator.x
+        return np.array(self.frame.out(x.T))
+
+    def set_waves(self, velocity, acceleration, elevation=None) -> None:
+        """The waves' water velocity [m/s] and acceleration [m/s^2] at :meth:`wave_points` (N, D each, the scene's
+        frame; a [flow] current is added on top) and the surface's elevation above the sea's level [m] there (N;
+        default 0, the mean level), used by every force evaluation until the next call, in place of the scene's own
+        ``[waves]`` (module doc)."""
+        from .model.forces.sea import GIVEN, GIVEN_WAVES
+
+        self._need_sea("set_waves")
+        n, dim = self.model.nodes, self.model.dim
+        u = self._node_values(velocity, (n, dim), "velocity")
+        a = self._node_values(acceleration, (n, dim), "acceleration")
+        eta = np.zeros(n) if elevation is None else self._node_values(elevation, (n,), "elevation")
+        sea = self.model.params.sea
+        given = sea.nodes[GIVEN:GIVEN + 7]
+        given[0] = eta
+        given[1:1 + dim] = self.frame.into(u).T
+        given[4:4 + dim] = self.frame.into(a).T
+        sea.scalars[GIVEN_WAVES] = 1.0
+
+    def _need_sea(self, call: str) -> None:
+        if not self._has_sea():
+            raise CouplingError(f"{self.scene.name}: {call}: the scene has no [sea], so there is no water whose "
+                                f"kinematics could be given; add [sea] (its level is the mean surface)")
+
+    def _node_values(self, values, shape: tuple, what: str) -> np.ndarray:
+        """``values`` as a float array of ``shape`` (or as many numbers flat, MoorDyn's layout), every one finite."""
+        try:
+            a = np.array(values, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise CouplingError(f"{self.scene.name}: set_waves: {what}: not an array of numbers") from None
+        if a.size != math.prod(shape):
+            raise CouplingError(f"{self.scene.name}: set_waves: {what}: {a.size} numbers of shape {a.shape}; give "
+                                f"{' x '.join(map(str, shape))} (one per node of wave_points())")
+        a = a.reshape(shape)
+        bad = np.flatnonzero(~np.isfinite(a.ravel()))
+        if bad.size:
+            k = int(bad[0]) // (shape[1] if len(shape) > 1 else 1)
+            value = float(a.ravel()[bad[0]])
+            raise CouplingError(f"{self.scene.name}: set_waves: {what} at node {k} is {value!r}; every value must be a "
+                                f"finite number")
+        return a
+
     # -- state ---------------------------------------------------------------------------------------------
 
     COUPLING_STATE = ("coupling_held_x0", "coupling_held_v", "coupling_base", "coupling_body_pose0",
-                      "coupling_body_base", "coupling_dt")
+                      "coupling_body_base", "coupling_dt", "coupling_waves", "coupling_waves_given")
 
     def state(self) -> dict[str, np.ndarray]:
         """The complete state (copies): the integrator's and the coupled objects' motion of the last step."""
@@ -271,6 +388,12 @@ class Coupling:
         out = self.integrator.state()
         out.update(coupling_held_x0=self.model.held_x0.copy(), coupling_held_v=self.integrator.held.v.copy(),
                    coupling_base=m.base.copy(), coupling_dt=np.array(self.integrator.grid.dt))
+        if self._has_sea():
+            from .model.forces.sea import GIVEN, GIVEN_WAVES
+
+            sea = self.model.params.sea
+            out.update(coupling_waves=sea.nodes[GIVEN:GIVEN + 7].copy(),
+                       coupling_waves_given=np.array(sea.scalars[GIVEN_WAVES]))
         if m.bodies is not None:
             out.update(coupling_body_pose0=m.bodies.accel.copy(), coupling_body_base=m.bodies.base.copy())
         return out
@@ -287,6 +410,12 @@ class Coupling:
         if m.bodies is not None:
             np.copyto(m.bodies.accel, state["coupling_body_pose0"])
             np.copyto(m.bodies.base, state["coupling_body_base"])
+        if self._has_sea() and "coupling_waves" in state:
+            from .model.forces.sea import GIVEN, GIVEN_WAVES
+
+            sea = self.model.params.sea
+            np.copyto(sea.nodes[GIVEN:GIVEN + 7], state["coupling_waves"])
+            sea.scalars[GIVEN_WAVES] = float(state["coupling_waves_given"])
         self.integrator.restore({k: v for k, v in state.items() if k not in self.COUPLING_STATE})
 
     def checkpoint(self) -> None:
@@ -357,6 +486,36 @@ class Coupling:
                                 f"objects have {self.dofs} degrees of freedom ({self.layout()})")
         return a
 
+    def _into(self, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Positions and velocities of the coupled objects in the scene's frame -> the y-up twin's (see the module
+        doc); the arrays themselves for a y-up scene."""
+        if not self.frame.turned:
+            return x, v
+        bad = np.flatnonzero(~np.isfinite(np.concatenate([x, v])))
+        if bad.size:     # refused before turning (a NaN angle would not survive the rotation's clamp)
+            self._refuse(int(bad[0]), x, v)
+        tx, tv = np.empty_like(x), np.empty_like(v)
+        for o in self.objects:
+            s = o.first
+            tx[s:s + 3], tv[s:s + 3] = P @ x[s:s + 3], P @ v[s:s + 3]
+            if o.kind == "body":
+                angles = angles_of(P @ rotation_of(x[s + 3:s + 6]) @ P.T)
+                tx[s + 3:s + 6] = angles
+                tv[s + 3:s + 6] = angle_rates(angles, P @ angular_velocity(x[s + 3:s + 6], v[s + 3:s + 6]))
+        return tx, tv
+
+    def _out(self, forces: np.ndarray) -> np.ndarray:
+        """Forces and moments on the coupled objects in the twin -> the scene's frame (in place)."""
+        if self.frame.turned:
+            for start in range(0, self.dofs, 3):     # 3-D: every object's DOF come in threes
+                forces[start:start + 3] = P.T @ forces[start:start + 3]
+        return forces
+
+    def _refuse(self, bad: int, x: np.ndarray, v: np.ndarray):
+        what, a, k = ("positions", x, bad) if bad < self.dofs else ("velocities", v, bad - self.dofs)
+        raise CouplingError(f"{self.scene.name}: {what}[{k}] = {float(a[k])!r} ({self._dof_name(k)}); every value "
+                            f"must be a finite number")
+
     def layout(self) -> str:
         """The arrays' layout in words: 'spar: x y z rx ry rz, fairlead1: x y z'."""
         return ", ".join(f"{o.id}: {' '.join(self._names(o))}" for o in self.objects)
@@ -393,11 +552,11 @@ class Coupling:
             from .model.coupled import begin_step
 
             self._begin_step = Direct(self.model.kernel(begin_step))
-        bad = self._begin_step.fast(float(t0), x, v, self._objects, held, state_x, state_v)
+        elif type(self._begin_step) is Direct and self._begin_step.entry is not None:
+            self._begin_step = self._begin_step.entry      # its compiled copy itself from now on
+        bad = self._begin_step(float(t0), x, v, self._objects, held, state_x, state_v)
         if bad >= 0:     # nothing was moved
-            what, a, k = ("positions", x, bad) if bad < self.dofs else ("velocities", v, bad - self.dofs)
-            raise CouplingError(f"{self.scene.name}: {what}[{k}] = {float(a[k])!r} ({self._dof_name(k)}); every value "
-                                f"must be a finite number")
+            self._refuse(bad, x, v)
 
     def _solve_statics(self) -> None:
         from .model.build import EquilibriumError
@@ -424,7 +583,7 @@ class Coupling:
         save_every = max(1, round(scene.output.interval / h))
         grid = TimeGrid(dt=h, steps=UNBOUNDED_STEPS, save_every=save_every, requested_dt=scene.integrator.dt)
         self.integrator = make_integrator(self.model, grid)
-        self._no_frames = None
+        self._quiet = None
         self.integrator.warm_up()
         self.integrator.loop = Direct(self.integrator.loop)   # its arguments keep their types: no dispatch
         self._loop_acc = self.integrator.last_accelerations
@@ -463,13 +622,18 @@ class Coupling:
         i = self.integrator
         tick = time.perf_counter()
         self._begin(i.step * i.grid.dt, x, v, i.held, i.x, i.v)
-        if i.frames_in(n):
+        save_every = i.grid.save_every      # a coupling's grid has no end: frames are due at multiples of it
+        if (i.step + n) // save_every != i.step // save_every:
             frames = i.new_frames(n)
-        else:                               # most coupling steps save no frame: the same empty buffers
-            if self._no_frames is None:
-                self._no_frames = i.new_frames(0)
-            frames = self._no_frames
-        done, written, status, node = i._run(n, frames)     # Integrator.advance, without its bundling
+            done, written, status, node = i._run(n, frames)     # Integrator.advance, without its bundling
+        else:    # most coupling steps save no frame: the loop's arguments are kept, but for the Schedule
+            quiet = self._quiet
+            if quiet is None or quiet[2] != n:
+                args = list(i.loop_args(n, i.new_frames(0)))
+                quiet = self._quiet = (args, tuple(args[SCHEDULE_AT])[2:], n)
+            args, rest, _ = quiet
+            args[SCHEDULE_AT] = Schedule(i.step, n, *rest)
+            done, written, status, node = i.loop(*args)
         if type(i.loop) is Direct:          # after its first call the loop is its compiled copy itself
             i.loop = i.loop.fast
         i.step += done
@@ -510,14 +674,17 @@ class Coupling:
             from .model.coupled import held_forces
 
             self._held = Direct(self.model.kernel(held_forces))
+        elif type(self._held) is Direct and self._held.entry is not None:
+            self._held = self._held.entry
         out = np.zeros(self.dofs)
-        self._held.fast(i.x, self._loop_acc, i.step * i.grid.dt, self.model.mass, self._objects, *self._held_args,
+        self._held(i.x, self._loop_acc, i.step * i.grid.dt, self.model.mass, self._objects, *self._held_args,
                         out)
         self._last_acc = self._loop_acc
         return out
 
     def node_accelerations(self) -> np.ndarray:
-        """The accelerations (D, N) of the evaluation the last forces came from (m a is each node's net force)."""
+        """The accelerations (D, N) of the evaluation the last forces came from (m a is each node's net force), in
+        the frame the model computes in (a z-up scene's y-up twin)."""
         return self._last_acc
 
     def _finish(self) -> None:

@@ -236,3 +236,59 @@ def test_rk4_reports_its_last_stages_forces_within_its_step_error_of_the_end_sta
         assert np.array_equal(reported.integrator.x, evaluated.integrator.x)
     assert np.all(worst < 1e-4), worst
     assert evaluated._end_forces() == pytest.approx(reported._end_forces(), rel=1e-15)
+
+
+def _twin_motion(angles, rates):
+    """The y-up twin's angles and angle rates of a z-up body's (R = Rz Ry Rx in each frame's axes), by scipy:
+    R' = P R P^T, the angular velocity w = c' e_z + b' Rz(c) e_y + a' Rz(c) Ry(b) e_x turned by P, and the twin's
+    rates that give it."""
+    from scipy.spatial.transform import Rotation
+
+    def columns(a):
+        rz, ry = Rotation.from_euler("z", a[2]).as_matrix(), Rotation.from_euler("y", a[1]).as_matrix()
+        return np.column_stack([rz @ ry @ [1.0, 0, 0], rz @ [0, 1.0, 0], [0, 0, 1.0]])
+
+    R = Rotation.from_euler("xyz", angles).as_matrix()
+    twin = Rotation.from_matrix(P_TURN @ R @ P_TURN.T).as_euler("xyz")
+    w = P_TURN @ columns(angles) @ rates
+    return twin, np.linalg.solve(columns(twin), w)
+
+
+P_TURN = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])      # z-up coordinates -> the y-up twin's
+
+
+def test_a_z_up_coupling_gives_its_y_up_twins_forces_in_its_own_frame():
+    """The same spar, coupled in a z-up scene (MoorDyn's frame) and in its y-up twin, with the same motion (the
+    twin's turned by P, its angles and rates by scipy): the forces and moments, and the mass matrix, are the same
+    up to the axis permutation (x, y, z)_z-up = (x, -z, y)_y-up, to 1e-12 of their largest value."""
+    from dataclasses import replace
+
+    from ropesim.scene.schema import scene_to_toml
+
+    y_scene = coupled_scene()
+    z_scene = ropesim.scene_from_toml(scene_to_toml(replace(y_scene, up="z")), source="oc3_z_up.toml")
+    assert z_scene.up == "z" and replace(z_scene, up="y", given_orientations=()) == y_scene
+    z, y = ropesim.Coupling(z_scene), ropesim.Coupling(y_scene)
+    x0 = np.array([0.5, -0.3, 0.2, 0.02, -0.03, 0.04])
+    v = np.array([0.3, -0.2, 0.1, 0.01, 0.02, -0.015])
+
+    def twin(t):
+        x = x0 + v * t
+        angles, rates = _twin_motion(x[3:], v[3:])
+        return np.concatenate([P_TURN @ x[:3], angles]), np.concatenate([P_TURN @ v[:3], rates])
+
+    def out(f):
+        return np.concatenate([P_TURN.T @ f[:3], P_TURN.T @ f[3:]])
+
+    pairs = [(z.init(x0, v), out(y.init(*twin(0.0))))]
+    for k in range(20):
+        t = 0.01 * k
+        pairs.append((z.step(t, 0.01, x0 + v * t, v), out(y.step(t, 0.01, *twin(t)))))
+    ours, theirs = np.array(pairs).transpose(1, 0, 2)
+    for part in (slice(0, 3), slice(3, 6)):
+        assert np.max(np.abs(ours[:, part] - theirs[:, part])) <= 1e-12 * np.max(np.abs(theirs[:, part]))
+    assert np.abs(theirs[:, :3]).max() > 1e6           # the chains pull (the comparison is not of zeros)
+    turn = np.kron(np.eye(2), P_TURN)
+    assert np.allclose(z.mass(), turn.T @ y.mass() @ turn, rtol=0, atol=1e-12 * np.abs(y.mass()).max())
+    with pytest.raises(CouplingError, match=r"positions\[4\] = nan \(spar ry\)"):
+        z.step(z.t, 0.01, np.array([0, 0, 0, 0, np.nan, 0]), v)

@@ -25,7 +25,8 @@ DATA = Path(__file__).parent / "data" / "moordyn"
 MOORING = DATA / "mooring"
 RUNS, DATA_FILE = "imports and runs", "a data file another input reads (not copied)"
 ROD = "uses rods (ROD TYPES): ropesim has no rods yet"
-WAVES = "uses wave kinematics (WaveKin): ropesim has no waves yet"
+WAVES = ("uses wave kinematics from MoorDyn's wave files or grids (WaveKin = {}): ropesim reads WaveKin = 1 "
+         "(kinematics given through the coupling calls); its own waves are [waves]").format
 CURRENTS = ("uses currents that vary in time or across the sea (Currents = {}): ropesim's [flow] is steady and varies "
             "with height only (Currents = 1 is read)")
 NOT_INPUT = "not a MoorDyn input file: no line of it opens a MoorDyn section (---- LINE TYPES ----, ---- LINES ----, ...)"
@@ -34,7 +35,7 @@ NOT_INPUT = "not a MoorDyn input file: no line of it opens a MoorDyn section (--
 # the refusal's line number and message.
 MOORDYN_TESTS_MOORING = {
     "3D_seafloor/current_profile.txt": DATA_FILE,
-    "3D_seafloor/hanging_lines.txt": (55, WAVES),
+    "3D_seafloor/hanging_lines.txt": (55, WAVES(3)),
     "3D_seafloor/make_3d_seafloor.py": DATA_FILE,
     "3D_seafloor/make_waves.py": DATA_FILE,
     "3D_seafloor/seafloor_profile_3d.txt": DATA_FILE,
@@ -71,7 +72,7 @@ MOORDYN_TESTS_MOORING = {
     "local_euler/duplicated.txt": RUNS,
     "local_euler/hanging.txt": RUNS,
     **{f"lowe_and_langley_2006/Case {i}.csv": DATA_FILE for i in range(1, 7)},
-    "lowe_and_langley_2006/line.txt": (30, WAVES),
+    "lowe_and_langley_2006/line.txt": RUNS,
     "moorpy_ic.py": DATA_FILE,
     "pendulum.txt": RUNS,
     "polyester/motion.csv": DATA_FILE,
@@ -98,7 +99,7 @@ MOORDYN_TESTS_MOORING = {
     "viv/current_profile.txt": (None, NOT_INPUT),
     "viv/viv.txt": (6, "line type 'cable' has a lift coefficient Cl (VIV): ropesim has no vortex-induced vibration"),
     "wave_surface/wave_frequencies.txt": DATA_FILE,
-    "wave_surface/wave_surface.txt": (40, WAVES),
+    "wave_surface/wave_surface.txt": (40, WAVES(7)),
     "wavekin_2/current_profile.txt": DATA_FILE,
     "wavekin_2/current_profile_4d.txt": DATA_FILE,
     "wavekin_2/current_profile_dynamic.txt": DATA_FILE,
@@ -106,8 +107,9 @@ MOORDYN_TESTS_MOORING = {
     "wavekin_2/water_grid.txt": DATA_FILE,
     "wavekin_2/wave_elevation.txt": DATA_FILE,
     "wavekin_2/wave_frequencies.txt": DATA_FILE,
-    **{f"wavekin_2/{name}.txt": (28, WAVES) for name in ("wavekin_2", "wavekin_2_curr2", "wavekin_2_curr5",
-                                                          "wavekin_3", "wavekin_3_curr2", "wavekin_3_curr5")},
+    **{f"wavekin_2/{name}.txt": (28, WAVES(name[8])) for name in ("wavekin_2", "wavekin_2_curr2",
+                                                                    "wavekin_2_curr5", "wavekin_3", "wavekin_3_curr2",
+                                                                    "wavekin_3_curr5")},
     "wavekin_3/current_profile_dynamic.txt": DATA_FILE,
     "wavekin_3/test_dynamic_currents.txt": (31, CURRENTS.format(2)),
     "wavekin_4/current_profile_4d.txt": DATA_FILE,
@@ -116,9 +118,9 @@ MOORDYN_TESTS_MOORING = {
     "wavekin_4/water_grid.txt": DATA_FILE,
     "wavekin_7/water_grid.txt": DATA_FILE,
     "wavekin_7/wave_frequencies.txt": DATA_FILE,
-    "wavekin_7/wavekin_7.txt": (29, WAVES),
-    "wavekin_current_1.txt": (28, WAVES),
-    "wavekin_wave_1.txt": (28, WAVES),
+    "wavekin_7/wavekin_7.txt": (29, WAVES(7)),
+    "wavekin_current_1.txt": RUNS,     # WaveKin = 1: a [sea], the waves given through the coupling calls
+    "wavekin_wave_1.txt": RUNS,
 }
 COPIED = sorted(name for name, what in MOORDYN_TESTS_MOORING.items() if what != DATA_FILE)
 IMPORTED = sorted(name for name, what in MOORDYN_TESTS_MOORING.items() if what == RUNS)

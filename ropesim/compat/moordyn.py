@@ -12,9 +12,10 @@ ropesim by changing its import::
 Every array is in MoorDyn's frame and units: z up, SI, angles in radians. The scene is read by
 :func:`ropesim.load_scene`: a ropesim scene, or a MoorDyn v2 input file as ``ropesim run`` reads it; its coupled
 points and bodies (``kind = "coupled"``, MoorDyn's Coupled and Vessel objects) are the coupled degrees of
-freedom, bodies first, then points, each in the scene's order, as MoorDyn orders them. A y-up scene's
-coordinates are turned: MoorDyn's (x, y, z) is the scene's (x, z, -y). Calls run through
-:class:`ropesim.Coupling`, whose documentation says what a coupling step does.
+freedom, bodies first, then points, each in the scene's order, as MoorDyn orders them. A MoorDyn file reads
+as a z-up scene (``up = "z"``), whose frame is MoorDyn's: nothing is turned here. A y-up scene's coordinates are
+turned: MoorDyn's (x, y, z) is the scene's (x, z, -y). Calls run through :class:`ropesim.Coupling`, whose
+documentation says what a coupling step does.
 
 A coupled body's angles are MoorDyn's (roll, pitch, yaw, R = Rx Ry Rz, ``Euler2Quat``) and its angular
 velocity the world-axes one MoorDyn moves its points with; both are turned into the scene's angles (R = Rz Ry
@@ -24,7 +25,8 @@ angles do, two paths that agree to second order in the rotation over one couplin
 Not supported, one line each (a call raises :class:`NotImplementedError` saying so):
 
 - rods (``GetRod`` and every rod getter): ropesim has no rods;
-- external wave kinematics (``ExternalWaveKinInit``, ``ExternalWaveKinSet``, ``GetWaves``): ropesim has no sea state yet;
+- ``GetWaves`` (MoorDyn's wave object): the waves are given (``ExternalWaveKinSet``) or the scene's own ``[waves]``;
+- a surface elevation with external wave kinematics (MoorDyn's calls give none: the surface stays at the sea's level), and a point's own entry (its line ends' are used);
 - ``GetSeafloor`` (a bathymetry file): ropesim's seabed is flat;
 - ``Log`` and ``SetVerbosity`` are accepted and do nothing: ropesim writes no log file;
 - ``Serialize`` / ``Deserialize`` (bytes in MoorDyn's format): use ``SaveState`` / ``LoadState`` (ropesim's own file, a NumPy .npz);
@@ -42,13 +44,16 @@ from pathlib import Path
 
 import numpy as np
 
-from ..coupling import Coupling, CouplingError
+from ..coupling import Coupling, CouplingError, angle_rates, angles_of
+from ..scene.frame import P, frame_of
 
 __all__ = ["Create", "NCoupledDOF", "Init", "Init_NoIC", "Step", "Close", "GetNumberLines", "GetNumberPoints",
            "GetNumberBodies", "GetLine", "GetPoint", "GetBody", "GetLineID", "GetPointID", "GetBodyID",
            "GetLineN", "GetLineNumberNodes", "GetLineUnstretchedLength", "GetLineNodePos", "GetLineNodeTen",
            "GetLineFairTen", "GetFASTtens", "GetPointPos", "GetPointVel", "GetPointForce", "GetPointNAttached",
-           "GetBodyState", "GetBodyForce", "SaveState", "LoadState", "Log", "SetVerbosity", "MoorDynError"]
+           "GetBodyState", "GetBodyForce", "SaveState", "LoadState", "Log", "SetVerbosity", "ExternalWaveKinInit",
+           "ExternalWaveKinGetN", "ExternalWaveKinGetCoordinates", "GetWaveKinCoordinates", "ExternalWaveKinSet",
+           "SetWaveKin", "MoorDynError"]
 
 MoorDynError = CouplingError
 
@@ -61,9 +66,11 @@ class System:
             raise CouplingError(f"{scene.name}: MoorDyn's calls move 3-D systems; this scene is 2-D")
         self.coupling = Coupling(scene)
         self.scene = scene
-        # P turns MoorDyn's (z-up) coordinates into the coupling's, ropesim's y-up frame, (x, y, z) -> (x, z, -y),
-        # whatever the scene's up: a z-up scene (up = "z") computes, and is coupled, in its y-up twin
-        self.turn = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])
+        # turn: MoorDyn's coordinates -> the scene's, whose frame the coupling takes: nothing for a z-up scene
+        # (up = "z", as a MoorDyn file reads), P: (x, y, z) -> (x, z, -y) for a y-up one. inside: MoorDyn's ->
+        # the model's own arrays, always its y-up twin's (the getters read them)
+        self.turn = np.eye(3) if frame_of(scene).turned else P
+        self.inside = P
         self.last_x = self.last_v = None
         self.forces = None
 
@@ -82,14 +89,14 @@ class System:
             raise CouplingError(f"{self.scene.name}: x and xd need {c.dofs} numbers each (NCoupledDOF), got "
                                 f"{x.size} and {v.size}")
         out_x, out_v = np.empty(c.dofs), np.empty(c.dofs)
-        P = self.turn
+        turn = self.turn
         for o in c.objects:
             s = o.first
-            out_x[s:s + 3], out_v[s:s + 3] = P @ x[s:s + 3], P @ v[s:s + 3]
+            out_x[s:s + 3], out_v[s:s + 3] = turn @ x[s:s + 3], turn @ v[s:s + 3]
             if o.kind == "body":
-                angles = scene_angles(P @ moordyn_rotation(*x[s + 3:s + 6]) @ P.T)
+                angles = angles_of(turn @ moordyn_rotation(*x[s + 3:s + 6]) @ turn.T)
                 out_x[s + 3:s + 6] = angles
-                out_v[s + 3:s + 6] = angle_rates(angles, P @ v[s + 3:s + 6])
+                out_v[s + 3:s + 6] = angle_rates(angles, turn @ v[s + 3:s + 6])
         return out_x, out_v
 
     def to_moordyn(self, forces: np.ndarray) -> list[float]:
@@ -101,8 +108,9 @@ class System:
                 out[start:start + 3] = back @ forces[start:start + 3]
         return out.tolist()
 
-    def vector(self, scene_vector) -> list[float]:
-        return (self.turn.T @ np.asarray(scene_vector, dtype=float)).tolist()
+    def vector(self, inside_vector) -> list[float]:
+        """A vector of the model's own arrays (the y-up twin's) in MoorDyn's frame."""
+        return (self.inside.T @ np.asarray(inside_vector, dtype=float)).tolist()
 
     # -- state now ------------------------------------------------------------------------------------------
 
@@ -126,21 +134,6 @@ def moordyn_rotation(roll: float, pitch: float, yaw: float) -> np.ndarray:
     ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
     rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
     return rx @ ry @ rz
-
-
-def scene_angles(R: np.ndarray) -> np.ndarray:
-    """The scene's angles (about x, then y, then z: R = Rz(c) Ry(b) Rx(a)) of rotation matrix R [rad]."""
-    b = -math.asin(max(-1.0, min(1.0, R[2, 0])))
-    return np.array([math.atan2(R[2, 1], R[2, 2]), b, math.atan2(R[1, 0], R[0, 0])])
-
-
-def angle_rates(angles: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """The rates of the scene's angles (a, b, c) that turn a body at angular velocity w (world axes):
-    w = a' u3 + b' u2 + c' e_z, u2 = Rz(c) e_y, u3 = Rz(c) Ry(b) e_x (:func:`ropesim.model.motion.rigid_state`)."""
-    _, b, c = angles
-    u3 = [math.cos(c) * math.cos(b), math.sin(c) * math.cos(b), -math.sin(b)]
-    u2 = [-math.sin(c), math.cos(c), 0.0]
-    return np.linalg.solve(np.array([u3, u2, [0.0, 0.0, 1.0]]).T, w)
 
 
 @dataclass(frozen=True)
@@ -234,13 +227,77 @@ def _unsupported(name: str, why: str):
 
 GetRod = _unsupported("GetRod", "ropesim has no rods")
 GetNumberRods = lambda instance: 0  # noqa: E731  (a system without rods)
-ExternalWaveKinInit = _unsupported("ExternalWaveKinInit", "ropesim has no sea state yet")
-ExternalWaveKinSet = _unsupported("ExternalWaveKinSet", "ropesim has no sea state yet")
-GetWaves = _unsupported("GetWaves", "ropesim has no sea state yet")
+GetWaves = _unsupported("GetWaves", "the waves are given (ExternalWaveKinSet) or the scene's own [waves]")
 GetSeafloor = _unsupported("GetSeafloor", "ropesim's seabed is flat (no bathymetry file)")
 Serialize = _unsupported("Serialize", "use SaveState (ropesim's own .npz file)")
 Deserialize = _unsupported("Deserialize", "use LoadState (ropesim's own .npz file)")
 GetLineNodeCurv = _unsupported("GetLineNodeCurv", "ropesim does not report curvature")
+
+
+# -- external wave kinematics (MoorDyn's WaveKin = 1) ---------------------------------------------------------
+
+
+def _wave_nodes(instance: System) -> np.ndarray:
+    """The model's node of each of MoorDyn's wave points: every line's nodes from its start (node 0) to its end,
+    line by line, then each point's first line end (MoorDyn's Waves::getWaveKinematicsPoints order)."""
+    from ..model.layout import point_ends
+
+    nodes = [node for layout in instance.model.lines for node in range(layout.first, layout.end)]
+    ends = point_ends(instance.scene, instance.model.lines)
+    return np.array(nodes + [ends[p.id][0] for p in instance.scene.points], dtype=np.int64)
+
+
+def ExternalWaveKinInit(instance: System) -> int:
+    """The number of points where the waves' kinematics are wanted (call after :func:`Init`); the scene needs a
+    ``[sea]`` (a MoorDyn file with WaveKin = 1 imports with one)."""
+    instance.coupling.wave_points()       # refuses a scene without a sea in one line
+    instance.wave_nodes = _wave_nodes(instance)
+    return len(instance.wave_nodes)
+
+
+def ExternalWaveKinGetN(instance: System) -> int:
+    return len(getattr(instance, "wave_nodes", ()))
+
+
+def ExternalWaveKinGetCoordinates(instance: System) -> list[list[float]]:
+    """The points (n, 3) where :func:`ExternalWaveKinSet` wants the waves, now (MoorDyn's frame)."""
+    x, _ = instance.state()
+    nodes = _need_wave_init(instance, "ExternalWaveKinGetCoordinates")
+    return (instance.inside.T @ x[:, nodes]).T.tolist()
+
+
+GetWaveKinCoordinates = ExternalWaveKinGetCoordinates
+
+
+def ExternalWaveKinSet(instance: System, u, a, t: float = 0.0) -> int:
+    """The waves' velocity ``u`` and acceleration ``a`` (n, 3 each, MoorDyn's frame) at the points of
+    :func:`ExternalWaveKinGetCoordinates`, used until they are set again (t is not read, as MoorDyn does not);
+    0."""
+    nodes = _need_wave_init(instance, "ExternalWaveKinSet")
+    n = len(nodes)
+    on_lines = nodes[:n - len(instance.scene.points)]
+    values = []
+    for what, given in (("u", u), ("a", a)):
+        try:
+            array = np.array(given, dtype=float).reshape(n, 3)
+        except (TypeError, ValueError):
+            raise CouplingError(f"{instance.scene.name}: ExternalWaveKinSet: {what} needs {n} x 3 numbers (one row "
+                                f"per point of ExternalWaveKinGetCoordinates), got {np.size(given)}") from None
+        per_node = np.zeros((instance.model.nodes, 3))
+        per_node[on_lines] = array[:len(on_lines)] @ instance.turn.T     # the scene's frame
+        values.append(per_node)
+    instance.coupling.set_waves(*values)
+    return 0
+
+
+SetWaveKin = ExternalWaveKinSet
+
+
+def _need_wave_init(instance: System, call: str) -> np.ndarray:
+    nodes = getattr(instance, "wave_nodes", None)
+    if nodes is None:
+        raise CouplingError(f"{instance.scene.name}: {call} before ExternalWaveKinInit; call it once after Init")
+    return nodes
 
 
 # -- lines, points, bodies ----------------------------------------------------------------------------------
@@ -351,7 +408,7 @@ def GetFASTtens(instance: System, n_lines: int):
     out = ([], [], [], [])
     for layout in instance.model.lines[:int(n_lines)]:
         for k, node in ((0, layout.end - 1), (2, layout.first)):
-            f = instance.turn.T @ forces[:, node]
+            f = instance.inside.T @ forces[:, node]
             out[k].append(float(math.hypot(f[0], f[1])))
             out[k + 1].append(float(f[2]))
     return out

@@ -76,6 +76,7 @@ from .health import LEDGER_COLUMNS, OK, initial_ledger, limits
 CHECK_EVERY = 64   # steps between blow-up checks: a blow-up is caught within this many steps
 
 Schedule = namedtuple("Schedule", ["step0", "n_steps", "total_steps", "h", "save_every", "check_every"])
+SCHEDULE_AT = -3     # where the Schedule sits among a loop's arguments (Integrator.loop_args)
 """Which steps a call runs: from global step ``step0``, ``n_steps`` steps of ``h`` [s] out of ``total_steps``;
 a frame every ``save_every`` steps and at the last, a health check every ``check_every``."""
 
@@ -229,6 +230,12 @@ class Integrator:
 
     def _run(self, n: int, frames: Frames) -> tuple:
         """Run the compiled loop for ``n`` steps from ``self.step``; (steps done, frames written, status, node)."""
+        return self.loop(*self.loop_args(n, frames))
+
+    def loop_args(self, n: int, frames: Frames) -> tuple:
+        """The compiled loop's arguments for ``n`` steps from ``self.step``: the integrator's own arrays and
+        bundles (the same objects for its whole life: :meth:`restore` copies into them), the :class:`Schedule` at
+        index :data:`SCHEDULE_AT`, then ``frames`` and the bodies' bundle."""
         raise NotImplementedError
 
     @property

@@ -118,10 +118,10 @@ class RungeKuttaFamily(Integrator):
         # at y + h sum_j a_sj K_j, which differs from the end state by O(h^2) (rk4: y + h K_3)
         return self.scratch.acc if self.method.c[-1] == 1.0 else None
 
-    def _run(self, n, frames):
+    def loop_args(self, n, frames):
         m = self.model
-        return self.loop((self.x, self.v, self.ledger), self.tables, self.scratch, self.held, m.mass, self.gamma,
-                         m.params, self.limits, self.schedule(n), frames, self.bodies)
+        return ((self.x, self.v, self.ledger), self.tables, self.scratch, self.held, m.mass, self.gamma, m.params,
+                self.limits, self.schedule(n), frames, self.bodies)
 
 
 @jit.kernel

@@ -143,9 +143,9 @@ class SdirkFamily(Integrator):
         """Newton iterations so far."""
         return int(self.stats[0])
 
-    def _run(self, n, frames):
-        return self.loop((self.x, self.v, self.ledger, self.stats), self.stage, self.newton, self.held, self.nodes,
-                         self.model.params, self.limits, self.schedule(n), frames, self.bodies)
+    def loop_args(self, n, frames):
+        return ((self.x, self.v, self.ledger, self.stats), self.stage, self.newton, self.held, self.nodes,
+                self.model.params, self.limits, self.schedule(n), frames, self.bodies)
 
 
 @jit.kernel

@@ -222,10 +222,10 @@ class Splitting(Integrator):
         # velocity-dependent forces rule out reusing the last kick's forces
         return self.step * (len(self.method.kick) - (1 if self.reuse_force else 0))
 
-    def _run(self, n, frames):
+    def loop_args(self, n, frames):
         m = self.model
-        return self.loop(self.bundle, self.kicks, self.plain, self.general, self.held, m.mass, m.params, self.limits,
-                         self.schedule(n), frames, self.bodies)
+        return (self.bundle, self.kicks, self.plain, self.general, self.held, m.mass, m.params, self.limits,
+                self.schedule(n), frames, self.bodies)
 
 
 @jit.kernel

@@ -341,11 +341,13 @@ class _Translator:
         return Translation(self.scene, self.comments, self.notes)
 
     def _refuse_options(self) -> None:
-        for name, why in (("wavekin", "wave kinematics (WaveKin): ropesim has no waves yet"),
+        for name, why in (("wavekin", "wave kinematics from MoorDyn's wave files or grids (WaveKin = {}): ropesim reads "
+                                      "WaveKin = 1 (kinematics given through the coupling calls); its own waves are "
+                                      "[waves]"),
                           ("currents", "currents that vary in time or across the sea (Currents = {}): ropesim's "
                                        "[flow] is steady and varies with height only (Currents = 1 is read)")):
             value = self.options.get(name, ("0", None))[0]
-            if value in ("0", "0.0") or (name == "currents" and value in ("1", "1.0")):
+            if value in ("0", "0.0") or value in ("1", "1.0"):
                 continue
             self.fail(self.options[name][1], f"uses {why.format(value)}")
         if "seafloorfile" in self.options:
@@ -402,6 +404,14 @@ class _Translator:
         self.scene["buoyancy"] = {}
         self.comments["fluid"] = ("MoorDyn's WtrDnsty. ropesim has no free surface: a node above z = 0 still feels "
                                   "buoyancy and drag (MoorDyn counts a node's wetted fraction)")
+        if self.options.get("wavekin", ("0", None))[0] in ("1", "1.0"):
+            self.scene["sea"] = {"level": 0.0}
+            self.comments["fluid"] = "MoorDyn's WtrDnsty"
+            self.comments["sea"] = ("MoorDyn's WaveKin = 1: the coupled program gives the waves' velocity and "
+                                    "acceleration at the nodes (ExternalWaveKinSet; ropesim.Coupling.set_waves), held "
+                                    "until it gives them again; still water until then. The surface is flat at "
+                                    "z = 0 (MoorDyn's calls give no elevation): each node feels the water on its "
+                                    "part below it, as MoorDyn counts a node's wetted fraction")
 
     # ------------------------------------------------------------------------------------ line types
 

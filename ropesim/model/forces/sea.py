@@ -32,6 +32,11 @@ with a volume) is a sphere of its volume: f_b = (u + 1)^2 (2 - u) / 4, u = (surf
   body) on the velocity relative to the water, u_w = U_current + u_waves, and the air's on the rest, the same
   coefficients times rho_air / rho_water, on the velocity relative to the ``wind``. Air adds no buoyancy.
 
+**Water kinematics from outside** (MoorDyn's external wave kinematics; :meth:`ropesim.Coupling.set_waves`): with
+the scalar ``GIVEN_WAVES`` set, every evaluation takes each node's surface elevation, the waves' velocity and
+acceleration from the rows ``GIVEN`` (what the coupled program last gave, held until it gives them again) instead
+of computing the waves; a ``[flow]`` current is added on top as always.
+
 Above the surface a node gets the surface's water kinematics (:mod:`ropesim.model.waves`), but only its
 submerged part feels them. With a sea the ramping current's inertia force ([flow] ``ramp_time``) is this
 term's too, on the submerged part (the :mod:`~ropesim.model.forces.flow_inertia` term is off).
@@ -73,15 +78,16 @@ WITH_WAVES = jit.Switch("waves", "waves on the sea")
 
 Sea = namedtuple("Sea", ["scalars", "comps", "nodes"])
 
-# the surface's scalars, after the waves'
-AIR_RATIO, WIND_X, WIND_Y, WIND_Z = range(WAVE_SCALARS, WAVE_SCALARS + 4)
-SCALAR_COUNT = WAVE_SCALARS + 4
+# the surface's scalars, after the waves'; GIVEN_WAVES: 1 when the waves' kinematics come from outside
+AIR_RATIO, WIND_X, WIND_Y, WIND_Z, GIVEN_WAVES = range(WAVE_SCALARS, WAVE_SCALARS + 5)
+SCALAR_COUNT = WAVE_SCALARS + 5
 
 # per-node rows of Sea.nodes: constants, then the state of the last evaluation, then scratch
 (LIFT_LINE, LIFT_BODY, RADIUS, SPHERE, KN, KT, KB, AN, AT, AB, OWNED, HALF_LO, HALF_HI,
  ETA, UX, UY, UZ, AX, AY, AZ, F_LINE, F_BODY) = range(22)
 WORK = 22
-NODE_STATE_ROWS = WORK + NODE_ROWS
+GIVEN = WORK + NODE_ROWS     # 7 rows as ETA to AZ: the kinematics given from outside
+NODE_STATE_ROWS = GIVEN + 7
 
 
 # ------------------------------------------------------------------------------------- submerged parts
@@ -181,7 +187,11 @@ def water_state(x, p, t):
     sea = p.sea
     scalars, nodes = sea.scalars, sea.nodes
     dim, n = x.shape
-    if WITH_WAVES:
+    if scalars[GIVEN_WAVES] != 0.0:
+        for r in range(7):
+            for i in range(n):
+                nodes[ETA + r, i] = nodes[GIVEN + r, i]
+    elif WITH_WAVES:
         node_kinematics(x, t, scalars, sea.comps, nodes[WORK:WORK + NODE_ROWS], nodes[ETA:AZ + 1])
     else:
         for r in range(ETA, AZ + 1):
