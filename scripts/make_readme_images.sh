@@ -84,7 +84,7 @@ ropesim plot "$runs/helicopter_sling" -o "$out/helicopter_sling_plot.png" -q
 ropesim run mooring_chain_waves -o "$runs/mooring_chain_waves" -q
 ropesim frames "$runs/mooring_chain_waves" --times 100,102.5,105,107.5 --columns 2 --width 760 \
     -o "$out/mooring_chain_waves.png" -q
-ropesim animate "$runs/mooring_chain_waves" --start 60 --end 120 --speed 4 --fps 10 --size 480 \
+ropesim animate "$runs/mooring_chain_waves" --start 60 --end 100 --speed 4 --fps 10 --size 480 \
     -o "$out/mooring_chain_waves.gif" -q
 ropesim plot "$runs/mooring_chain_waves" -o "$out/mooring_chain_waves_plot.png" -q
 ropesim run floating_hose -o "$runs/floating_hose" -q

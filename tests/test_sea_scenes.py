@@ -126,3 +126,24 @@ def test_the_side_view_draws_the_surface_at_the_frames_time():
     u, v = profile.surface.get_data()
     assert np.allclose(v, airy(1.0, 8.0, 30.0, u, np.full_like(u, 12.5), 8.0), atol=1e-12)
     assert not SeaProfile(ax, scene, Projection((0, 2))).active
+
+
+def test_the_3d_view_draws_the_surface_as_a_wireframe_at_the_frames_time():
+    """The 3-D view's wireframe heights are the mean level plus the waves' elevation over the box, at the frame's
+    time and shifted with a followed view."""
+    from matplotlib.figure import Figure
+
+    from ropesim.render.sea_artist import SeaWireframe
+    from ropesim.render.view3d import axes_3d
+
+    scene = ropesim.load_scene("floating_hose", ["dimension=3", "initial.start=[0.0, 0.0, 0.0]",
+                                                 "initial.end=[60.0, 0.0, 0.0]", "sea.probes=[[30.0, 0.0]]"])
+    box = np.array([[-5.0, 65.0], [-3.0, 3.0], [-10.0, 10.0]])
+    ax = axes_3d(Figure(), [0, 0, 1, 1], box, False)
+    shift = np.array([2.0, 0.5, -1.0])
+    wire = SeaWireframe(ax, scene, box)
+    wire.show(9.0, shift)
+    for segment in wire.mesh.get_segments()[:3]:
+        X, Y, Z = np.asarray(segment).T      # matplotlib's (x, -z, y)
+        want = airy(1.0, 8.0, 30.0, X + shift[0], np.full_like(X, 9.0), 8.0) - shift[1]
+        assert np.allclose(Z, want, atol=1e-12)

@@ -74,18 +74,25 @@ class SeaWireframe:
             return
         self.gx = np.linspace(*box[0], GRID_LINES)
         self.gz = np.linspace(*box[2], GRID_LINES)
-        self.mesh = Line3DCollection([], colors=SURFACE_COLOR, linewidths=0.5, alpha=0.55, zorder=1.5)
-        ax.add_collection3d(self.mesh)
+        self.mesh = Line3DCollection(self._segments(np.full((GRID_LINES, GRID_LINES), scene.sea.level),
+                                                    np.zeros(3)),
+                                     colors=SURFACE_COLOR, linewidths=0.5, alpha=0.55, zorder=1.5)
+        ax.add_collection3d(self.mesh, autolim=False)
         self.artists = [self.mesh]
+
+    def _segments(self, height: np.ndarray, shift: np.ndarray) -> list:
+        """The wireframe's lines (each grid row and column) of surface heights (G, G) over the shifted grid."""
+        from .view3d import plotted
+
+        X, Z = np.meshgrid(self.gx, self.gz, indexing="ij")
+        grid = np.stack(plotted(np.stack([X, height, Z], axis=-1)), axis=-1)   # (G, G, 3)
+        return list(grid) + list(grid.transpose(1, 0, 2))
 
     def show(self, t: float, shift: np.ndarray | None = None) -> None:
         """The surface at time ``t`` [s]; ``shift`` (3,) [m] the followed nodes' centre."""
         if not self.active:
             return
-        from .view3d import plotted
-
         s = np.zeros(3) if shift is None else np.asarray(shift, dtype=float)
         X, Z = np.meshgrid(self.gx, self.gz, indexing="ij")
         height = self.scene.sea.level + elevation(self.scene, t, X + s[0], Z + s[2]) - s[1]
-        grid = np.stack(plotted(np.stack([X, height, Z], axis=-1)), axis=-1)   # (G, G, 3)
-        self.mesh.set_segments(list(grid) + list(grid.transpose(1, 0, 2)))
+        self.mesh.set_segments(self._segments(height, s))
