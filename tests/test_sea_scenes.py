@@ -57,6 +57,9 @@ def test_the_hose_heaves_with_the_surface_at_long_periods_and_the_probes_hold_ai
     for k, x in enumerate((0.0, 30.0, 60.0)):
         assert np.allclose(run.probe_elevation[:, k], airy(1.0, 20.0, 30.0, x, run.t, 20.0), atol=1e-12)
     assert np.all((run.line_submerged > 0.45) & (run.line_submerged < 0.55))
+    rope = run.line("rope")       # the same, by line
+    assert np.array_equal(rope.submerged_total, run.line_submerged[:, 0])
+    assert rope.submerged.shape == (len(run.t), 31)
 
 
 def test_the_chain_fairlead_tension_range_grows_with_hs():
@@ -147,3 +150,35 @@ def test_the_3d_view_draws_the_surface_as_a_wireframe_at_the_frames_time():
         X, Y, Z = np.asarray(segment).T      # matplotlib's (x, -z, y)
         want = airy(1.0, 8.0, 30.0, X + shift[0], np.full_like(X, 9.0), 8.0) - shift[1]
         assert np.allclose(Z, want, atol=1e-12)
+
+
+def test_an_interrupted_run_keeps_the_sea_and_resumes_it_bit_for_bit(tmp_path):
+    """SIGTERM mid-run: the folder holds the sea's arrays up to its checkpoint, and `--resume` finishes them
+    exactly as an uninterrupted run writes them."""
+    import signal
+    import time
+
+    sets = [a for s in ("integrator.t_end=30.0", "output.interval=0.05") for a in ("--set", s)]
+    clean, folder = tmp_path / "clean", tmp_path / "run"
+    command = [sys.executable, "-m", "ropesim", "run", "floating_hose", "-q", *sets]
+    assert subprocess.run(command + ["-o", str(clean)], capture_output=True).returncode == 0
+    proc = subprocess.Popen(command + ["-o", str(folder)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    stream = folder / "checkpoint" / "submerged.npy"
+    deadline = time.time() + 120
+    while time.time() < deadline and proc.poll() is None:
+        if stream.exists() and stream.stat().st_size > 256 + 4 * 31 * 8:
+            break
+        time.sleep(0.01)
+    proc.send_signal(signal.SIGTERM)
+    proc.communicate(timeout=120)
+    want = ropesim.Trajectory.open(clean)
+    if proc.returncode == 143:        # (else it finished before the signal came)
+        cut = ropesim.Trajectory.open(folder)
+        assert cut.summary["status"] == "interrupted" and 1 <= cut.frames < want.frames
+        assert np.array_equal(cut.probe_elevation, want.probe_elevation[:cut.frames])
+        done = subprocess.run([sys.executable, "-m", "ropesim", "run", "--resume", str(folder), "-q"],
+                              capture_output=True, text=True)
+        assert done.returncode == 0, done.stderr
+    got = ropesim.Trajectory.open(folder)
+    for name in ("x", "submerged", "line_submerged", "probe_elevation"):
+        assert np.array_equal(getattr(got, name), getattr(want, name)), name

@@ -75,7 +75,9 @@ def sea_frames(model, t: np.ndarray, x: np.ndarray) -> dict[str, np.ndarray]:
     for k, line in enumerate(model.lines):
         w = weight[line.first:line.end]
         share = submerged[:, line.first:line.end]
-        lines[:, k] = share @ w / w.sum() if w.sum() > 0 else share.mean(axis=1)
+        # row by row (not a matrix product, whose summation order follows the chunk's frame count): a
+        # resumed run's frames are its uninterrupted twin's bit for bit
+        lines[:, k] = (share * w).sum(axis=1) / w.sum() if w.sum() > 0 else share.mean(axis=1)
     out = {"submerged": submerged, "line_submerged": lines}
     if scene.sea.probes:
         out["probe_elevation"] = probe_elevation(scene, t)
