@@ -128,6 +128,10 @@ def test_the_side_view_draws_the_surface_at_the_frames_time():
     profile.show(12.5, np.zeros((31, 2)))
     u, v = profile.surface.get_data()
     assert np.allclose(v, airy(1.0, 8.0, 30.0, u, np.full_like(u, 12.5), 8.0), atol=1e-12)
+    offset = np.array([-4.0, 0.25])     # a followed view: drawn minus the followed node's position
+    profile.show(12.5, np.zeros((31, 2)), offset)
+    u, v = profile.surface.get_data()
+    assert np.allclose(v - offset[1], airy(1.0, 8.0, 30.0, u - offset[0], np.full_like(u, 12.5), 8.0), atol=1e-12)
     assert not SeaProfile(ax, scene, Projection((0, 2))).active
 
 
