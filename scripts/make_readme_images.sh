@@ -4,7 +4,7 @@
 # shapes (plus the plot of the one with the end mass), the string shooters as small GIFs of their default runs
 # (the real one, string_shooter_real, slowed down, with a frame sheet), the moorings and the beam (frames,
 # the chain's swing as a GIF, and each one's plot with its tensions), and the systems of lines (each one's
-# frames, an animation and its plot).
+# frames, an animation and its plot), and the sea's scenes (the chain in waves, the floating hose).
 #
 #     scripts/make_readme_images.sh        # about three minutes on two cores; prints the pictures' total size
 set -euo pipefail
@@ -78,4 +78,18 @@ ropesim frames "$runs/helicopter_sling" --follow --overlay --view xy --times 0,5
 ropesim animate "$runs/helicopter_sling" --follow --end 48 --speed 4 --fps 5 --size 360 \
     -o "$out/helicopter_sling.gif" -q
 ropesim plot "$runs/helicopter_sling" -o "$out/helicopter_sling_plot.png" -q
+
+# the sea: the chain in an irregular sea (a frame sheet over one peak period, a minute animated, its tensions),
+# and the floating hose riding its waves (over one period, two periods animated)
+ropesim run mooring_chain_waves -o "$runs/mooring_chain_waves" -q
+ropesim frames "$runs/mooring_chain_waves" --times 100,102.5,105,107.5 --columns 2 --width 760 \
+    -o "$out/mooring_chain_waves.png" -q
+ropesim animate "$runs/mooring_chain_waves" --start 60 --end 100 --speed 4 --fps 10 --size 480 \
+    -o "$out/mooring_chain_waves.gif" -q
+ropesim plot "$runs/mooring_chain_waves" -o "$out/mooring_chain_waves_plot.png" -q
+ropesim run floating_hose -o "$runs/floating_hose" -q
+ropesim frames "$runs/floating_hose" --times 40,42,44,46 --columns 2 --width 760 -o "$out/floating_hose.png" -q
+ropesim animate "$runs/floating_hose" --start 40 --end 56 --speed 2 --fps 10 --size 480 \
+    -o "$out/floating_hose.gif" -q
+ropesim plot "$runs/floating_hose" -o "$out/floating_hose_plot.png" -q
 du -ch "$out"/* | tail -1

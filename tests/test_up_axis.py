@@ -318,6 +318,7 @@ ca_normal = 1.0
 [sea]
 level = 0.0
 wind = {wind}
+probes = {probes}
 [waves]
 kind = "regular"
 height = 1.0
@@ -339,11 +340,17 @@ def test_a_line_through_the_surface_in_oblique_waves_and_wind_is_its_y_up_twin()
     run either way up."""
     start, end, wind = [0.0, -6.0, 0.0], [10.0, 3.0, 4.0], [5.0, 0.5, 2.0]
     fmt = lambda v: "[" + ", ".join(repr(float(c)) for c in v) + "]"    # noqa: E731
-    y_up = scene_from_toml(SEA_TWIN.format(up="", start=fmt(start), end=fmt(end), wind=fmt(wind)))
+    y_up = scene_from_toml(SEA_TWIN.format(up="", start=fmt(start), end=fmt(end), wind=fmt(wind),
+                                           probes="[[3.0, -2.0], [0.0, 0.0]]"))    # (x, z)
     z_up = scene_from_toml(SEA_TWIN.format(up='up = "z"', start=fmt(out(start)), end=fmt(out(end)),
-                                           wind=fmt(out(wind))))
+                                           wind=fmt(out(wind)), probes="[[3.0, 2.0], [0.0, 0.0]]"))   # (x, y)
     y_run, z_run = simulate(y_up), simulate(z_up)
     assert np.ptp(y_run.x[..., 1], axis=0).max() > 0.01          # the waves and the weight move it
     for name in ("x", "v"):
         assert_close(getattr(z_run, name), turned_out(getattr(y_run, name)), name)
     np.testing.assert_allclose(z_run.tension, y_run.tension, rtol=1e-12, atol=1e-12 * np.max(y_run.tension))
+    # the sea's records are scalars: the same numbers either way up (a probe at the twin's (x, z) = (x, -y))
+    assert np.ptp(y_run.probe_elevation[:, 0]) > 0.1
+    np.testing.assert_array_equal(z_run.probe_elevation, y_run.probe_elevation)
+    np.testing.assert_allclose(z_run.submerged, y_run.submerged, rtol=0, atol=1e-9)
+    assert 0.0 < y_run.line_submerged.min() and y_run.line_submerged.max() < 1.0   # it crosses the surface

@@ -43,6 +43,7 @@ KINDS = {
     "dof_rows": "table",
     "inertia": "inertia",
     "wave_rows": "table",
+    "horizontal": "list of positions",
 }
 
 # What a key left out means when the schema's default is None ("work it out from the rest of the scene").
@@ -176,6 +177,7 @@ def allowed(spec) -> str:
         "points": "N vectors",
         "rows": "rows of t and `dimension` numbers, t increasing",
         "wave_rows": "rows of 4 numbers: amplitude > 0, angular frequency > 0, phase, direction",
+        "horizontal": "2-D: x each; 3-D: 2 numbers each (x, z; z up: x, y); over water",
         "angles": "3 numbers in 3-D (about x, y, z), 1 in 2-D (about z)",
         "dofs": "6 numbers in 3-D (x, y, z, then about x, y, z), 3 in 2-D (x, y, about z)",
         "dof_rows": "rows of t and one number per degree of freedom (6 in 3-D, 3 in 2-D), t increasing",

@@ -95,11 +95,14 @@ class LineResults:
     - ``start_tension``, ``end_tension`` (F,) [N]: its first and last segments';
     - ``start_force``, ``end_force`` (F, D) [N]: the force its start and its end put on what they are attached
       to (see the module: the end segment's tension along it, towards the line); None for a closed loop;
-    - ``start``, ``end``: the ids of the points it joins (None for a rope).
+    - ``start``, ``end``: the ids of the points it joins (None for a rope);
+    - with a ``[sea]``: ``submerged`` (F, n), each node's fraction below the surface, and ``submerged_total``
+      (F,), the line's fraction of its length (:mod:`ropesim.model.sea_frames`); None without one.
     """
 
-    def __init__(self, traj, layout: LineLayout, segment0: int, start: str | None, end: str | None):
-        self.traj, self.layout = traj, layout
+    def __init__(self, traj, layout: LineLayout, segment0: int, start: str | None, end: str | None,
+                 index: int = 0):
+        self.traj, self.layout, self.index = traj, layout, index
         self.id, self.start, self.end = layout.id, start, end
         self.first, self.nodes, self.closed = layout.first, layout.nodes, layout.closed
         self.segments = slice(segment0, segment0 + layout.segments)   # in the trajectory's tension and strain
@@ -117,6 +120,18 @@ class LineResults:
     @property
     def velocities(self) -> np.ndarray:
         return self.traj.v[:, self.first:self.first + self.nodes]
+
+    @property
+    def submerged(self) -> np.ndarray | None:
+        if self.traj.submerged is None:
+            return None
+        return self.traj.submerged[:, self.first:self.first + self.nodes]
+
+    @property
+    def submerged_total(self) -> np.ndarray | None:
+        if self.traj.line_submerged is None:
+            return None
+        return self.traj.line_submerged[:, self.index]
 
     @cached_property
     def tension(self) -> np.ndarray:
@@ -170,8 +185,8 @@ def every_line(traj) -> dict[str, LineResults]:
     scene = traj.scene
     layouts = line_layouts(scene)
     ends = [(line.start, line.end) for line in scene.lines] if scene.is_system else [(None, None)]
-    return {layout.id: LineResults(traj, layout, s0, *joins)
-            for layout, s0, joins in zip(layouts, _segment_offsets(layouts), ends)}
+    return {layout.id: LineResults(traj, layout, s0, *joins, index=k)
+            for k, (layout, s0, joins) in enumerate(zip(layouts, _segment_offsets(layouts), ends))}
 
 
 def line_results(traj, id: str) -> LineResults:

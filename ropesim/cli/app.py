@@ -1043,6 +1043,9 @@ def export(
     the force tables go by line end and support point, and STEM_bodies.csv holds each body's pose, velocities,
     force and moment per frame.
 
+    With a [sea]: a submerged column (each node's fraction below the surface) and STEM_sea.csv (per frame: each
+    line's submerged fraction and the surface's elevation at each of [sea] probes); VTK point data submerged.
+
     NetCDF is not offered: xarray with h5py would add about 120 MB to hold the three arrays trajectory.npz
     already holds (numpy.load reads it; xarray wraps it in one call).
     """

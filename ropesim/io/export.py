@@ -16,7 +16,10 @@ csv     One CSV file in long format for spreadsheets: a header row naming each c
         where they reach kilonewtons, the unit in each header): ``<stem>_tension_history.csv``, a row per
         frame with the end tensions and each support's force, and ``<stem>_tension_range.csv``, a row per
         segment with its position along the rope and its tension's min, max, mean and std over the run (or the
-        window ``--from``/``--to``). Written with numpy alone.
+        window ``--from``/``--to``). Written with numpy alone. With a ``[sea]`` the positions table has a
+        ``submerged`` column (each node's fraction below the surface) and ``<stem>_sea.csv`` a row per frame
+        with each line's submerged fraction and the surface's elevation at each probe (VTK: point data
+        ``submerged``).
 
 NetCDF is not offered: through xarray it needs xarray, pandas, h5netcdf and h5py, about 120 MB installed (meshio
 is 2 MB), to write the three arrays that ``trajectory.npz`` already holds, in a file no smaller (215 KB against
@@ -127,6 +130,8 @@ def export(traj, fmt: str, out: str | Path | None = None, start: float | None = 
                                                    (output_file(range_path(real)), _range)]
         if traj.scene.rigid_bodies and traj.body_x is not None:
             tables.append((output_file(bodies_path(real)), _bodies))
+        if traj.line_submerged is not None:
+            tables.append((output_file(sea_path(real)), _sea))
         files = [real]
         with atomic_output(real) as tmp:
             (_csv_lines if traj.scene.is_system else _csv)(traj, tmp, frames)
@@ -158,18 +163,32 @@ def _columns(dim: int) -> list[str]:
     return ["t [s]", "node", *(f"{a} [m]" for a in AXES[:dim]), *(f"v{a} [m/s]" for a in AXES[:dim])]
 
 
+def _node_values(traj, start: int, stop: int) -> np.ndarray:
+    """Frames start:stop's positions, velocities and (with a sea) submerged fractions, (k, N, columns)."""
+    parts = [np.asarray(traj.x[start:stop]), np.asarray(traj.v[start:stop])]
+    if traj.submerged is not None:
+        parts.append(np.asarray(traj.submerged[start:stop])[..., None])
+    return np.concatenate(parts, axis=2)
+
+
+def _value_columns(traj) -> list[str]:
+    dim = traj.x.shape[2]
+    return _columns(dim)[2:] + (["submerged [-]"] if traj.submerged is not None else [])
+
+
 def _csv(traj, path: Path, window: slice) -> None:
     _, nodes, dim = traj.x.shape
-    fmt = ["%.17g", "%d"] + ["%.17g"] * (2 * dim)
+    columns = _value_columns(traj)
+    fmt = ["%.17g", "%d"] + ["%.17g"] * len(columns)
     block = max(1, FRAME_ROWS // nodes)
     with open(path, "w", encoding="utf-8", newline="") as fh:
-        fh.write(",".join(_columns(dim)) + "\n")
+        fh.write(",".join(["t [s]", "node", *columns]) + "\n")
         for start in range(window.start, window.stop, block):
             stop = min(window.stop, start + block)
             t = np.repeat(np.asarray(traj.t[start:stop]), nodes)
             node = np.tile(np.arange(nodes), stop - start)
-            xv = np.concatenate([np.asarray(traj.x[start:stop]), np.asarray(traj.v[start:stop])], axis=2)
-            np.savetxt(fh, np.column_stack([t, node, xv.reshape(-1, 2 * dim)]), fmt=fmt, delimiter=",")
+            values = _node_values(traj, start, stop)
+            np.savetxt(fh, np.column_stack([t, node, values.reshape(-1, len(columns))]), fmt=fmt, delimiter=",")
 
 
 def _csv_lines(traj, path: Path, window: slice) -> None:
@@ -180,19 +199,41 @@ def _csv_lines(traj, path: Path, window: slice) -> None:
     lines = line_layouts(traj.scene)
     ids = np.array([_csv_text(line.id) for line in lines for _ in range(line.nodes)], dtype=object)
     along = np.concatenate([np.arange(line.nodes) for line in lines])
-    fmt = ["%.17g", "%s", "%d"] + ["%.17g"] * (2 * dim)
+    columns = _value_columns(traj)
+    fmt = ["%.17g", "%s", "%d"] + ["%.17g"] * len(columns)
     block = max(1, FRAME_ROWS // nodes)
     with open(path, "w", encoding="utf-8", newline="") as fh:
-        fh.write(",".join(["t [s]", "line", "node", *_columns(dim)[2:]]) + "\n")
+        fh.write(",".join(["t [s]", "line", "node", *columns]) + "\n")
         for start in range(window.start, window.stop, block):
             stop = min(window.stop, start + block)
-            xv = np.concatenate([np.asarray(traj.x[start:stop]), np.asarray(traj.v[start:stop])], axis=2)
-            table = np.empty((stop - start, nodes, 3 + 2 * dim), dtype=object)
+            table = np.empty((stop - start, nodes, 3 + len(columns)), dtype=object)
             table[:, :, 0] = np.asarray(traj.t[start:stop])[:, None]
             table[:, :, 1] = ids
             table[:, :, 2] = along
-            table[:, :, 3:] = xv
+            table[:, :, 3:] = _node_values(traj, start, stop)
             np.savetxt(fh, table.reshape(-1, table.shape[-1]), fmt=fmt, delimiter=",")
+
+
+def sea_path(out: Path) -> Path:
+    """Where the CSV export's table of the sea (submerged fractions, probes) goes, beside ``out``."""
+    return out.with_name(f"{out.stem}_sea.csv")
+
+
+def _sea(traj, path: Path, window: slice) -> None:
+    """A row per frame: t [s], each line's submerged fraction of its length and, with probes, the surface's
+    elevation above the mean level at each [m]."""
+    from ..model.layout import line_layouts
+
+    ids = [line.id for line in line_layouts(traj.scene)] if traj.scene.is_system else ["rope"]
+    columns = ["t [s]"] + [_csv_text(f"submerged {i} [-]") for i in ids]
+    parts = [np.asarray(traj.t[window])[:, None], np.asarray(traj.line_submerged[window])]
+    if traj.probe_elevation is not None:
+        axes = "x" if traj.scene.dimension == 2 else ("x y" if traj.frame.turned else "x z")
+        columns += [_csv_text(f"eta at {axes} = {' '.join(f'{c:g}' for c in p)} [m]") for p in traj.scene.sea.probes]
+        parts.append(np.asarray(traj.probe_elevation[window]))
+    with open(path, "w", encoding="utf-8", newline="") as fh:
+        fh.write(",".join(columns) + "\n")
+        np.savetxt(fh, np.column_stack(parts), fmt="%.17g", delimiter=",")
 
 
 def _csv_text(text: str) -> str:
@@ -361,8 +402,10 @@ def _vtk_parts(traj, meshio) -> list[tuple[str, str, object]]:
             x, v = padded(traj.x[i][nodes]), padded(traj.v[i][nodes])
             data = {} if traj.tension is None else {"tension": [np.asarray(traj.tension[i][segments], dtype=float)],
                                                     "strain": [np.asarray(traj.strain[i][segments], dtype=float)]}
-            return meshio.Mesh(x, [("line", cells)], cell_data=data,
-                               point_data={"velocity": v, "speed": np.linalg.norm(v, axis=1)})
+            point = {"velocity": v, "speed": np.linalg.norm(v, axis=1)}
+            if traj.submerged is not None:
+                point["submerged"] = np.asarray(traj.submerged[i][nodes], dtype=float)
+            return meshio.Mesh(x, [("line", cells)], cell_data=data, point_data=point)
         return mesh
 
     if traj.scene.is_system:

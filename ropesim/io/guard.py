@@ -34,7 +34,7 @@ HTML_MARK = '<meta name="generator" content="ropesim view">'   # ropesim.viewer.
 RUN_FILES = frozenset({*RUN_MARKERS, STATE, LOCK})
 DEFAULT_OUTPUTS = frozenset({"plots.png", "frames.png", "animation.gif", "animation.mp4", "trajectory.csv", "vtk",
                              "trajectory_tension_history.csv", "trajectory_tension_range.csv",
-                             "trajectory_bodies.csv"})
+                             "trajectory_bodies.csv", "trajectory_sea.csv"})
 CSV_HEADERS = ("t [s],node,",                         # ropesim export --to csv
                "t [s],line,node,",                    # ... of a system of lines
                "t [s],tension segment 0 [",           # ... its time history of the forces
@@ -42,6 +42,7 @@ CSV_HEADERS = ("t [s],node,",                         # ropesim export --to csv
                "segment,s [m],min tension [",         # ... its tension range along the rope
                "line,segment,s [m],min tension [",    # ... along each line of a system
                "t [s],body,",                         # ... a system's rigid bodies
+               "t [s],submerged ",                    # ... the sea: submerged fractions, probes
                "method,dt,steps,status,",             # ropesim accuracy: accuracy.csv
                "stiffness,method,dt,dt_over_ref",     # ropesim stability: stability.csv
                "stiffness,method,ref_dt,")            # ropesim stability: bounds.csv

@@ -22,7 +22,8 @@ from .frames import check_run_folder, read_run
 from .runfolder import SCENE, TRAJECTORY, RunFolderError
 
 ARRAYS = ("t", "x", "v")
-DERIVED = ("tension", "strain", "support", "held_force", "body_x", "body_q", "body_v", "body_w")
+DERIVED = ("tension", "strain", "support", "held_force", "body_x", "body_q", "body_v", "body_w", "submerged",
+           "line_submerged", "probe_elevation")
 """Per frame, derived from t, x and v (and the free bodies' states) as they are stored."""
 BODY_STATE = ("body_x", "body_v", "body_q", "body_w")   # a system's rigid bodies, in the scene's order
 
@@ -104,6 +105,10 @@ class Trajectory:
     angular velocity in world axes (2-D: about z alone), every body in the scene's order (None without rigid
     bodies). :meth:`line`, :meth:`point` and :meth:`body` give each object's results by its id.
 
+    With a ``[sea]``: ``submerged`` (F, N), each node's fraction below the instantaneous surface,
+    ``line_submerged`` (F, L), each line's fraction of its length, and with ``[sea] probes`` the surface's
+    elevation above the mean level at each, ``probe_elevation`` (F, P) [m] (:mod:`ropesim.model.sea_frames`).
+
     Every array is in the scene's own frame: a z-up scene's (``up = "z"``) are z-up, though the model computes
     in its y-up twin (:mod:`ropesim.scene.frame`; :attr:`internal` gives the run in that frame).
 
@@ -125,6 +130,9 @@ class Trajectory:
     body_q: np.ndarray | None = None   # (F, B, 4) its orientation, a unit quaternion (w, x, y, z), body to world
     body_v: np.ndarray | None = None   # (F, B, D) its reference point's velocity [m/s]
     body_w: np.ndarray | None = None   # (F, B, 3) its angular velocity in world axes [rad/s]
+    submerged: np.ndarray | None = None        # (F, N) each node's submerged fraction (a [sea]; else None)
+    line_submerged: np.ndarray | None = None   # (F, L) each line's submerged fraction of its length
+    probe_elevation: np.ndarray | None = None  # (F, P) the surface's elevation at each of [sea] probes [m]
 
     @property
     def frames(self) -> int:

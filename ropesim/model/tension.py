@@ -22,6 +22,7 @@ from .bodies import body_frames, body_shapes
 from .forces.fluid import flow_at
 from .forces.springs import segment_forces, segment_strains
 from .motion import Held, place_moving
+from .sea_frames import sea_frames, sea_shapes
 from .terms import accelerations
 
 
@@ -46,6 +47,7 @@ def frame_shapes(model) -> dict[str, tuple]:
         shapes["support"] = (model.held_idx.size, model.dim)
         shapes["held_force"] = (model.held_idx.size, model.dim)
     shapes.update(body_shapes(model))
+    shapes.update(sea_shapes(model))
     return shapes
 
 
@@ -59,6 +61,7 @@ def frame_arrays(model, t: np.ndarray, x: np.ndarray, v: np.ndarray, body: np.nd
         out["support"], out["held_force"] = held_forces(model, t, x, v)
     if model.scene.rigid_bodies:
         out.update(body_frames(model, t, body))
+    out.update(sea_frames(model, t, x))
     return out
 
 

@@ -23,6 +23,7 @@ from .framing import Projection, figure_inches, followed_nodes, origin, projecti
 from ..io.atomic import atomic_output
 from .output import output_path
 from .scene_artist import Geometry, RopeArtist, body_state, legend_handles, style_axes
+from .sea_artist import SeaProfile, SeaWireframe
 from .style import title_text, with_picture_text
 from .timeline import animation_plan
 from .view3d import wants_3d
@@ -69,11 +70,12 @@ class FrameRenderer:
         style_axes(ax, proj, layout.box, follow)
         picture_title(fig, model, proj)
         self.geometry = Geometry(ax, model, proj, animated=follow)
+        self.sea = SeaProfile(ax, model.scene, proj, animated=True)
         self.rope = RopeArtist(ax, model, proj, animated=True)
         # the time stamp, at the right of the title line: outside the view, so it never hides the rope
         self.stamp = fig.text(1 - 6 / layout.width, 1 - 3 / layout.height, "", ha="right", va="top", fontsize=9,
                               animated=True)
-        self.moving = (self.geometry.artists if follow else []) + self.rope.artists + [self.stamp]
+        self.moving = self.sea.artists + (self.geometry.artists if follow else []) + self.rope.artists + [self.stamp]
         self.canvas.draw()
         self.background = self.canvas.copy_from_bbox(fig.bbox)
 
@@ -84,6 +86,7 @@ class FrameRenderer:
             offset = -origin(x, self.nodes)[self.cols]
             self.geometry.move(offset)
         self.canvas.restore_region(self.background)
+        self.sea.show(float(self.traj.t[i]), x, offset)
         self.rope.show(x, offset, body_state(self.traj, i))
         self.stamp.set_text(f"t = {self.traj.t[i]:.2f} s")
         for artist in self.moving:
@@ -115,12 +118,13 @@ class FrameRenderer3D:
                           azim=azimuth(model, np.asarray(traj.x[0])), up=model.scene.up)
         picture_title(fig, model, VIEW_3D)
         self.geometry = Geometry3D(self.ax, model, box)
+        self.sea = SeaWireframe(self.ax, model.scene, box)
         self.state = State3D(self.ax, model)
         self.stamp = fig.text(1 - 6 / width, 1 - 3 / height, "", ha="right", va="top", fontsize=9)
         fixed = self.geometry.artists if nodes is not None else [a for a in self.geometry.artists
                                                                   if a is self.geometry.pinned]
         # in zorder, as a full drawing would: the fixed points' markers over the lines that end on them
-        self.moving = sorted(fixed + self.state.artists, key=lambda a: a.get_zorder()) + [self.stamp]
+        self.moving = sorted(fixed + self.sea.artists + self.state.artists, key=lambda a: a.get_zorder()) + [self.stamp]
         for artist in self.moving:
             artist.set_animated(True)
         self.canvas.draw()     # the axes, their projection and the fixed parts, once
@@ -132,6 +136,7 @@ class FrameRenderer3D:
         if self.nodes is not None:
             shift = origin(x, self.nodes)
             self.geometry.move(shift)
+        self.sea.show(float(self.traj.t[i]), shift)
         self.state.show(x, shift, body_state(self.traj, i))
         self.stamp.set_text(f"t = {self.traj.t[i]:.2f} s")
         self.canvas.restore_region(self.background)

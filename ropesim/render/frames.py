@@ -2,7 +2,8 @@
 3-5 and 8-10).
 
 Every panel (or every overlaid rope) uses the same fixed limits, from the whole run, so shapes compare
-directly; in the overlay older frames are lighter and fainter, the last one solid.
+directly; in the overlay older frames are lighter and fainter, the last one solid. A sea's surface is drawn at
+each panel's time (an overlay's: at its last frame's; :mod:`ropesim.render.sea_artist`).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from ..io.trajectory import Trajectory
 from .framing import figure_inches, fit_box, followed_nodes, origin, projection, view_aspect, view_box
 from .output import output_path, save_png
 from .scene_artist import Geometry, RopeArtist, body_state, legend_handles, style_axes
+from .sea_artist import SeaProfile, SeaWireframe
 from .style import OUTSIDE_RIGHT, title_text, with_picture_text
 from .timeline import chosen_frames
 from .view3d import wants_3d
@@ -110,6 +112,7 @@ def frame_sheet(traj: Trajectory, out: str | Path, *, times: list[float] | None 
             geometry = Geometry(ax, model, proj)
             if offset is not None:
                 geometry.move(offset)
+            SeaProfile(ax, model.scene, proj).show(t, x, offset)
             RopeArtist(ax, model, proj).show(x, offset, state)
             ax.set_title(f"t = {t:.2f} s", fontsize=9, pad=3)
         for ax in axes[len(frames):]:
@@ -160,6 +163,7 @@ def _sheet_3d(traj, model, real, out, indices, nodes, overlay, columns, width) -
         geometry = Geometry3D(ax, model, box)
         if shifts[-1] is not None:
             geometry.move(shifts[-1])
+        SeaWireframe(ax, model.scene, box).show(shown[-1], shifts[-1])   # the sea of the solid, last frame
         fades = np.linspace(*FADE, len(frames)) if len(frames) > 1 else np.array([FADE[1]])
         handles = []
         for (x, state), shift, t, f in zip(frames, shifts, shown, fades):
@@ -173,6 +177,7 @@ def _sheet_3d(traj, model, real, out, indices, nodes, overlay, columns, width) -
             geometry = Geometry3D(ax, model, box)
             if shift is not None:
                 geometry.move(shift)
+            SeaWireframe(ax, model.scene, box).show(t, shift)
             State3D(ax, model).show(x, shift, state)
             ax.set_title(f"t = {t:.2f} s", fontsize=9, pad=0)
     fig.suptitle(f"{model.scene.name}  ·  view 3d", x=0.01, ha="left", fontsize=10, fontweight="bold")
@@ -192,6 +197,7 @@ def _overlay(ax, model, proj, frames, offsets, times, states) -> None:
     geometry = Geometry(ax, model, proj)
     if offsets[-1] is not None:
         geometry.move(offsets[-1])
+    SeaProfile(ax, model.scene, proj).show(times[-1], frames[-1], offsets[-1])   # the sea of the solid, last frame
     fades = np.linspace(*FADE, len(frames)) if len(frames) > 1 else np.array([FADE[1]])
     handles = []
     for x, offset, t, f, state in zip(frames, offsets, times, fades, states):

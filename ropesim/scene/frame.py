@@ -35,6 +35,7 @@ TURNS = {
     "position": VECTOR, "velocity": VECTOR, "velocities": VECTOR, "amplitude": VECTOR, "path_table": VECTOR,
     "center_of_gravity": VECTOR, "center_of_buoyancy": VECTOR, "angular_velocity": VECTOR, "top": VECTOR,
     "start": VECTOR, "end": VECTOR, "points": VECTOR, "top_center": VECTOR, "center": VECTOR, "wind": VECTOR,
+    "probes": VECTOR,
     # one magnitude per axis (body axes or world axes): permuted
     "cd_area": AXES, "added_mass": AXES, "cd_rotation": AXES, "added_inertia": AXES, "stiffness": AXES,
     "damping": AXES, "period": AXES, "phase": AXES,
@@ -42,7 +43,7 @@ TURNS = {
 }
 """How each key of a geometric kind (vector, points, rows, angles, dofs, dof_rows, inertia) turns; a test checks
 that every such key of the schema is here."""
-GEOMETRIC_KINDS = ("vector", "points", "rows", "angles", "dofs", "dof_rows", "inertia")
+GEOMETRIC_KINDS = ("vector", "points", "rows", "angles", "dofs", "dof_rows", "inertia", "horizontal")
 
 # P: the z-up scene's coordinates -> the y-up twin's
 P = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
@@ -110,6 +111,8 @@ def turn_value(name: str, kind: str, value, into: bool):
         return one(value)
     if kind == "points":
         return tuple(one(p) for p in value)
+    if kind == "horizontal":   # (x,) in 2-D; 3-D: a z-up scene's (x, y) is the twin's (x, z) = (x, -y)
+        return tuple(p if len(p) == 1 else (p[0], _neg(p[1])) for p in value)
     if kind == "dofs":
         return one(value[:3]) + one(value[3:])
     if kind == "rows":

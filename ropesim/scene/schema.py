@@ -26,7 +26,8 @@ class Spec:
     """What one TOML key may hold.
 
     kind: "int", "float", "bool", "str", "vector" (one number per dimension), "int_list", "float_list",
-    "points" (a list of vectors) or "rows" (a table: rows of a time and one number per dimension); for rigid
+    "points" (a list of vectors), "horizontal" (a list of horizontal positions: x in 2-D, two numbers in 3-D)
+    or "rows" (a table: rows of a time and one number per dimension); for rigid
     bodies "angles" (one number per axis of rotation: 3 in 3-D, 1 in 2-D), "dofs" (a vector, then its angles:
     6 in 3-D, 3 in 2-D), "dof_rows" (rows of a time and the dofs) and "inertia" (3-D: 3 principal moments or 6,
     Ixx Iyy Izz Ixy Ixz Iyz, the entries of the symmetric tensor [[Ixx, Ixy, Ixz], [Ixy, Iyy, Iyz], [Ixz, Iyz,
@@ -283,6 +284,9 @@ class Sea:
                               low=0)
     wind: tuple | None = spec("vector", "the wind's velocity above the surface (default: still air)", "m/s",
                               default=None, required=False)
+    probes: tuple | None = spec("horizontal", "wave probes: where to record the surface's elevation every frame, "
+                                          "each a horizontal position (2-D: x; 3-D: x and the other horizontal "
+                                          "axis)", "m", default=None, required=False)
 
 
 WAVE_KINDS = ("regular", "jonswap", "pierson_moskowitz", "table")

@@ -50,6 +50,8 @@ def resolve_sea(scene: S.Scene, base_dir: Path, fail) -> S.Scene:
         fail("rigid_bodies", "a free rigid body does not yet feel a [sea]'s surface (its buoyancy, drag and "
                              "inertia assume it submerged); fix or drive it, or leave out [sea]")
     depth = _depth(scene, fail)
+    if sea.probes is not None:
+        _check_probes(scene, fail)
     if waves is not None:
         waves = _resolve_waves(waves, scene.dimension, base_dir, fail)
         _check_breaking(waves, depth, scene.gravity.g, fail)
@@ -68,6 +70,24 @@ def _depth(scene: S.Scene, fail) -> float:
         fail("sea.level", f"puts the mean water level at y = {sea.level:g} m, not above the seabed at y = "
                           f"{scene.seabed.height:g} m")
     return depth
+
+
+def _check_probes(scene: S.Scene, fail) -> None:
+    """The probes' domain is the water: wherever the seabed (its plane, sloping along x) lies below the mean
+    level, or everywhere without a seabed. A probe on the dry side of the shoreline is refused."""
+    bed = scene.seabed
+    if bed is None:
+        return
+    rise = math.tan(math.radians(bed.slope))
+    for i, probe in enumerate(scene.sea.probes):
+        x = probe[0]
+        floor = bed.height + rise * x
+        if not floor < scene.sea.level:
+            shore = (scene.sea.level - bed.height) / rise if rise else None
+            where = (f"the water ends at the shoreline x = {shore:.6g} m; keep x {'<' if rise > 0 else '>'} "
+                     f"{shore:.6g} m" if shore is not None else "the seabed is not below the mean level anywhere")
+            fail(f"sea.probes[{i}]", f"at x = {x:g} m is outside the sea: the seabed there (y = {floor:.6g} m) is "
+                                     f"not below the mean level y = {scene.sea.level:g} m ({where})")
 
 
 def _resolve_waves(waves: S.Waves, dim: int, base_dir: Path, fail) -> S.Waves:

@@ -103,6 +103,15 @@ def parse_value(value: Any, sp: S.Spec, key: str, source: str, dim: int):
         if not isinstance(value, list) or not value:
             bad(f"must be a list of points, each a list of {dim} numbers")
         return tuple(vector_of(p, dim, f"{key}[{i}]", source, sp) for i, p in enumerate(value))
+    if sp.kind == "horizontal":
+        n = dim - 1
+        if isinstance(value, list) and n == 1:   # 2-D: x alone may be written bare
+            value = [[v] if is_number(v) else v for v in value]
+        if not isinstance(value, list) or not value or len(value) > MAX_PATH_ROWS:
+            bad(f"must be a list of horizontal positions, each {'x' if n == 1 else 'a list of 2 numbers'} "
+                f"(at most {MAX_PATH_ROWS:,})")
+        return tuple(numbers_of(p, n, f"{key}[{i}]", source, sp, "x" if n == 1 else "the horizontal axes")
+                     for i, p in enumerate(value))
     if sp.kind == "wave_rows":
         ok = isinstance(value, list) and value and all(isinstance(row, list) for row in value)
         if not ok:
