@@ -123,9 +123,12 @@ def no_groups(dim: int) -> Groups:
 
 
 # ------------------------------------------------------------------------------------ the small pieces
+# lever and entry are compiled once each and linked, not inlined by Numba at each of their eight call sites
+# (Numba types an inlined body again at every site: 0.9 s more of a system's first run); LLVM still inlines
+# them into the loops, at the same speed.
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def lever(arm, k, dim, dof, b, col):
     """G_k[b, col] for member k (see the module doc): the identity on the translations, -[rho]x on a 3-D
     rotation vector, (-rho_y, rho_x) on a 2-D rotation."""
@@ -140,7 +143,7 @@ def lever(arm, k, dim, dof, b, col):
     return sign * arm[3 - b - r, k]
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def entry(band, row, col):
     """J[row, col] of the symmetric matrix whose lower triangle ``band`` holds."""
     return band[row - col, col] if row >= col else band[col - row, row]

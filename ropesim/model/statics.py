@@ -85,23 +85,19 @@ class Equilibrium:
     pose: np.ndarray = field(default_factory=lambda: np.zeros((7, 0)))
 
 
-@jit.kernel
-def forces_on_free_nodes(x, v, acc, p, t, mass, free, out):
+def forces_on_free_nodes(acceleration, x, v, acc, p, t, mass, free, out, junctions=None):
     """The net static force [N] on every free node (0 on held nodes) into ``out`` (flat, node-major), a free
-    point's on its first node (the sum over its line ends, the others 0); returns its largest component."""
-    accelerations(x, v, acc, p, t)
+    point's on its first node (the sum over its line ends, the others 0); returns its largest component (inf if
+    any is not a number). ``acceleration`` is the scene's compiled term list
+    (:func:`~ropesim.model.terms.accelerations`), the loop's own: the static solver compiles no copy of it."""
+    acceleration(x, v, acc, p, t)
     dim, n = x.shape
-    for i in range(n):
-        for d in range(dim):
-            out[i * dim + d] = mass[i] * acc[d, i] if free[i] else 0.0
-    if WITH_JUNCTIONS:
-        fold_junctions(out, p.junctions, dim)
-    worst = 0.0
-    for u in range(out.shape[0]):
-        f = out[u]
-        if abs(f) > worst or not f == f:
-            worst = abs(f) if f == f else np.inf
-    return worst
+    np.multiply(acc, mass, out=out.reshape(n, dim).T)
+    out.reshape(n, dim)[~free] = 0.0
+    if junctions is not None:
+        fold_junctions(out, junctions, dim)
+    worst = float(np.abs(out).max(initial=0.0))
+    return np.inf if worst != worst else worst
 
 
 def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
@@ -112,8 +108,8 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     pose = np.array(model.body_pose0 if pose is None else pose, dtype=float)
     dim, n = x.shape
     scene, p = model.scene, model.params
-    static_force, nonconservative, energy_of, jacobian, tangent_stiffness, factor, solve = (model.kernel(f) for f in (
-        forces_on_free_nodes, nonconservative_forces, mechanical_energy, newton_matrix, add_fluid_tangent_stiffness,
+    acceleration, nonconservative, energy_of, jacobian, tangent_stiffness, factor, solve = (model.kernel(f) for f in (
+        accelerations, nonconservative_forces, mechanical_energy, newton_matrix, add_fluid_tangent_stiffness,
         factor_newton_matrix, solve_newton_matrix))
     free = np.ascontiguousarray(~model.held)
     mass = model.mass
@@ -170,7 +166,7 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
         moment (over its size)."""
         if bodies is not None:
             bodies.place(x, pose)
-        worst = static_force(x, v, acc, p, t, mass, free, out)
+        worst = forces_on_free_nodes(acceleration, x, v, acc, p, t, mass, free, out, junctions)
         energy = float(energy_of(x, v, mass, p)[0])
         if bodies is None:
             return worst, float(np.linalg.norm(out)), energy
