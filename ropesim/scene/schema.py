@@ -283,6 +283,9 @@ class Sea:
                               low=0)
     wind: tuple | None = spec("vector", "the wind's velocity above the surface (default: still air)", "m/s",
                               default=None, required=False)
+    fraction: str = spec("str", "a node's submerged part: cylinders (its half segments cut by the surface at "
+                                "the node, exact) or moordyn (MoorDyn 2's rule, for comparing with it)",
+                         default="cylinders", choices=("cylinders", "moordyn"))
 
 
 WAVE_KINDS = ("regular", "jonswap", "pierson_moskowitz", "table")

@@ -14,6 +14,9 @@ at Archimedes' draught), a vertical one the fraction of its axis below the surfa
 continuous, as the stiff integrator's Newton solve needs. The node's line fraction f is the mean of its half
 segments' weighted by their unstretched lengths. A point body (a rope's ``[[bodies]]``, a system's free point
 with a volume) is a sphere of its volume: f_b = (u + 1)^2 (2 - u) / 4, u = (surface - y) / R.
+``[sea] fraction = "moordyn"`` puts MoorDyn 2's rule in place of the line's cylinders, to compare with it on
+equal physics (:func:`moordyn_line_fraction`): each segment's share below the mean of its two nodes' surface
+heights, measured along a diagonal of the segment; the Newton matrix keeps the cylinders' slope.
 
 **What acts on it**, with f and f_b at the state and time of every force evaluation:
 
@@ -74,8 +77,9 @@ WITH_WAVES = jit.Switch("waves", "waves on the sea")
 Sea = namedtuple("Sea", ["scalars", "comps", "nodes"])
 
 # the surface's scalars, after the waves'
-AIR_RATIO, WIND_X, WIND_Y, WIND_Z = range(WAVE_SCALARS, WAVE_SCALARS + 4)
-SCALAR_COUNT = WAVE_SCALARS + 4
+AIR_RATIO, WIND_X, WIND_Y, WIND_Z, FRACTION_RULE = range(WAVE_SCALARS, WAVE_SCALARS + 5)
+SCALAR_COUNT = WAVE_SCALARS + 5
+CYLINDERS, MOORDYN_RULE = 0.0, 1.0   # FRACTION_RULE: ``[sea] fraction``
 
 # per-node rows of Sea.nodes: constants, then the state of the last evaluation, then scratch
 (LIFT_LINE, LIFT_BODY, RADIUS, SPHERE, KN, KT, KB, AN, AT, AB, OWNED, HALF_LO, HALF_HI,
@@ -161,6 +165,52 @@ def line_fraction(x, i, around, surface, nodes):
 
 
 @jit.kernel(inline="always")
+def moordyn_segment_fraction(x, i, j, surface, r):
+    """MoorDyn 2's submerged fraction of the segment from node i to node j (i < j) under the plane y =
+    ``surface`` (its ``Line::calcSubSeg``, branch for branch): 1 or 0 with both ends below or above, 1/2 with
+    the ends at opposite heights, else the share below the surface of the diagonal from the lower end's
+    underside to the upper end's top side, each end moved by r cos(alpha) across the axis."""
+    dim = x.shape[0]
+    z_i, z_j = x[1, i] - surface, x[1, j] - surface
+    if z_i <= 0.0 and z_j < 0.0:
+        return 1.0
+    if z_i > 0.0 and z_j > 0.0:
+        return 0.0
+    if z_i == -z_j:
+        return 0.5
+    lower, upper = (z_i, z_j) if z_i < 0.0 else (z_j, z_i)
+    dx = x[0, j] - x[0, i]
+    dy = x[1, j] - x[1, i]
+    dz = x[2, j] - x[2, i] if dim == 3 else 0.0
+    flat = math.sqrt(dx * dx + dz * dz)
+    length = math.sqrt(flat * flat + dy * dy)
+    shift = r * flat / length if length > 0.0 else 0.0   # the vertical part of r times the up-most normal
+    lower -= shift
+    upper += shift
+    return abs(lower) / (abs(lower) + upper)
+
+
+@jit.kernel(inline="always")
+def moordyn_line_fraction(x, i, around, level, nodes):
+    """Node i's submerged fraction by MoorDyn 2's rule: its half segments weighted by their unstretched lengths,
+    each segment's fraction (:func:`moordyn_segment_fraction`) under the mean of its two nodes' surface heights
+    (MoorDyn's ``Line::getStateDeriv``); 1 on a node without a line volume."""
+    w_lo, w_hi = nodes[HALF_LO, i], nodes[HALF_HI, i]
+    total = w_lo + w_hi
+    r = nodes[RADIUS, i]
+    if total == 0.0 or r == 0.0:
+        return 1.0
+    f = 0.0
+    for side in range(2):
+        w = w_lo if side == 0 else w_hi
+        if w > 0.0:
+            j = around[side, i]
+            surface = level + 0.5 * (nodes[ETA, i] + nodes[ETA, j])
+            f += w * moordyn_segment_fraction(x, min(i, j), max(i, j), surface, r)
+    return f / total
+
+
+@jit.kernel(inline="always")
 def sphere_fraction(y, surface, radius):
     """(fraction, its derivative by y) of a sphere of ``radius`` centred at height y below ``surface``."""
     u = (surface - y) / radius
@@ -201,9 +251,13 @@ def water_state(x, p, t):
                 nodes[AY, i] += a1
                 nodes[AZ, i] += a2
     level = scalars[LEVEL]
+    moordyn = scalars[FRACTION_RULE] == MOORDYN_RULE
     for i in range(n):
         surface = level + nodes[ETA, i]
-        nodes[F_LINE, i] = line_fraction(x, i, p.neighbours, surface, nodes)[0]
+        if moordyn:
+            nodes[F_LINE, i] = moordyn_line_fraction(x, i, p.neighbours, level, nodes)
+        else:
+            nodes[F_LINE, i] = line_fraction(x, i, p.neighbours, surface, nodes)[0]
         nodes[F_BODY, i] = sphere_fraction(x[1, i], surface, nodes[SPHERE, i])[0] if nodes[SPHERE, i] > 0.0 else 1.0
     if WITH_ADDED_MASS:
         for i in range(n):
@@ -416,6 +470,7 @@ def _params(scene, layout) -> Sea:
     scalars[AIR_RATIO] = scene.sea.air_density / scene.fluid.density
     if scene.sea.wind is not None:
         scalars[WIND_X:WIND_X + scene.dimension] = scene.sea.wind
+    scalars[FRACTION_RULE] = MOORDYN_RULE if scene.sea.fraction == "moordyn" else CYLINDERS
     return Sea(scalars, comps, sea_nodes(scene, layout))
 
 
