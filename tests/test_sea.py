@@ -227,6 +227,11 @@ def test_sea_and_waves_keys_refused_with_one_line(tmp_path):
         "[waves]\nkind = \"regular\"\nheight = 1.0\nperiod = 5.0\nseed = 3\n": "waves.seed",
         "[waves]\nkind = \"swell\"\n": "waves.kind",
         "[viscous_drag]\nb_normal = 1.0\nb_tangential = 0.1\n": "viscous_drag",
+        "[drag]\nb = 0.1\n": "drag",
+        "[waves]\nkind = \"jonswap\"\nsignificant_height = 2.0\npeak_period = -8.0\n": "waves.peak_period",
+        "[waves]\nkind = \"jonswap\"\nsignificant_height = 12.0\npeak_period = 3.0\n": "waves.significant_height",
+        "[waves]\nkind = \"table\"\ntable = [[0.5, 1.0, 0.0]]\n": "waves.table",
+        "[waves]\nkind = \"regular\"\nheight = 1.0\nperiod = 5.0\nstretching = \"linear\"\n": "waves.stretching",
     }
     (tmp_path / "comps.csv").write_text("amplitude,frequency,phase\n0.5,1.0,0\n")
     for extra, key in cases.items():
@@ -309,3 +314,31 @@ def test_the_viewer_draws_the_sea():
         expect = -1.0 + field.elevation(water.x[:, None], content.t[frame], water.z[None, :])
         assert np.allclose(water.heights[[frame]][0], expect, rtol=0, atol=1e-12)
     assert np.ptp(water.heights[[3]]) > 0.4
+
+
+def test_check_names_the_sea_and_its_waves(tmp_path):
+    """`ropesim check` lists the sea among the force terms: level, depth, air, the waves' kind and figures (the
+    regular wave's length from the dispersion relation), stretching and ramp."""
+    path = tmp_path / "s.toml"
+    path.write_text(hose(4.0, extra="[waves]\nkind = \"regular\"\nheight = 1.0\nperiod = 5.0\nramp_time = 10.0\n"))
+    out = subprocess.run([sys.executable, "-m", "ropesim", "check", str(path)], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    text = " ".join(out.stdout.replace("│", " ").split())
+    length = 2 * math.pi * G / (2 * math.pi / 5.0) ** 2   # deep water: the hose's sea has no seabed
+    assert "sea (level y = 0 m, deep water, air 1.225 kg/m^3)" in text
+    assert f"regular waves H = 1 m, T = 5 s (L = {length:.4g} m), wheeler stretching, ramped over 10 s" in text
+
+
+def test_the_run_time_estimate_counts_the_waves():
+    """The estimate adds the sea's cost per node and evaluation, and each component's: a table of 200 is
+    evaluated directly, a spectrum of 200 by the recurrence (scripts/bench_waves.py measures both)."""
+    from ropesim.run import estimate
+
+    base = ropesim.scene_from_toml(hose(4.0))
+    table = "\n".join(f"  [0.01, {0.5 + 0.01 * j}, 0.0, 0.0]," for j in range(200))
+    direct = ropesim.scene_from_toml(hose(4.0, extra=f"[waves]\nkind = \"table\"\ntable = [\n{table}\n]\n"))
+    spectrum = ropesim.scene_from_toml(hose(4.0, extra="[waves]\nkind = \"jonswap\"\nsignificant_height = 1.0\n"
+                                                       "peak_period = 8.0\ncomponents = 200\n"))
+    still, slow, fast = (estimate(s).seconds for s in (base, direct, spectrum))
+    assert still < fast < slow
+    assert (slow - still) / (fast - still) == pytest.approx(36 / 2)   # the hose's [sea] is in all three

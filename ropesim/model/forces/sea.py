@@ -42,7 +42,8 @@ term's too, on the submerged part (the :mod:`~ropesim.model.forces.flow_inertia`
 :func:`water_state` computes every node's surface elevation, fractions and water kinematics for positions x at
 time t into the bundle's state rows, at every force evaluation and before every Newton matrix (the time
 factors of the waves are shared by every evaluation at one time, :func:`ropesim.model.waves.time_factors`).
-The numbers depend on (x, t) alone.
+The numbers depend on (x, t) alone, so a call at the last call's positions and time returns at once (sdirk2's
+Newton matrix asks at the stage's (x, t) its residual has just asked at).
 
 The Newton matrix (sdirk2) gets the drag's damping on both parts (fractions and tangent frozen) and the
 buoyancy's vertical stiffness at the surface, -m lift df/dy (:func:`add_sea_jacobian`); the stability bound the
@@ -77,14 +78,14 @@ WITH_WAVES = jit.Switch("waves", "waves on the sea")
 Sea = namedtuple("Sea", ["scalars", "comps", "nodes"])
 
 # the surface's scalars, after the waves'
-AIR_RATIO, WIND_X, WIND_Y, WIND_Z, FRACTION_RULE = range(WAVE_SCALARS, WAVE_SCALARS + 5)
-SCALAR_COUNT = WAVE_SCALARS + 5
+AIR_RATIO, WIND_X, WIND_Y, WIND_Z, FRACTION_RULE, STATE_TIME, STATE_VALID = range(WAVE_SCALARS, WAVE_SCALARS + 7)
+SCALAR_COUNT = WAVE_SCALARS + 7
 CYLINDERS, MOORDYN_RULE = 0.0, 1.0   # FRACTION_RULE: ``[sea] fraction``
 
 # per-node rows of Sea.nodes: constants, then the state of the last evaluation, then scratch
 (LIFT_LINE, LIFT_BODY, RADIUS, SPHERE, KN, KT, KB, AN, AT, AB, OWNED, HALF_LO, HALF_HI,
- ETA, UX, UY, UZ, AX, AY, AZ, F_LINE, F_BODY) = range(22)
-WORK = 22
+ ETA, UX, UY, UZ, AX, AY, AZ, F_LINE, F_BODY, AT_X, AT_Y, AT_Z) = range(25)
+WORK = 25
 NODE_STATE_ROWS = WORK + NODE_ROWS
 
 
@@ -224,13 +225,30 @@ def sphere_fraction(y, surface, radius):
 # --------------------------------------------------------------------------------------- the state
 
 
+@jit.kernel(inline="always")
+def _state_holds(x, t, scalars, nodes):
+    """True when the state rows already hold positions x at time t (the last call's, stored in AT_X..AT_Z)."""
+    if scalars[STATE_VALID] != 1.0 or scalars[STATE_TIME] != t:
+        return False
+    dim, n = x.shape
+    for i in range(n):
+        for a in range(dim):
+            if nodes[AT_X + a, i] != x[a, i]:
+                return False
+    return True
+
+
 @jit.kernel
 def water_state(x, p, t):
     """Every node's surface elevation, submerged fractions, the water's velocity and acceleration at positions x
-    (D, N) and time t [s] into the sea's state rows (module doc)."""
+    (D, N) and time t [s] into the sea's state rows (module doc). A call at the positions and time of the last
+    returns at once: they depend on (x, t) alone, and sdirk2 asks for them at the same (x, t) for a stage's
+    residual and for its Newton matrix."""
     sea = p.sea
     scalars, nodes = sea.scalars, sea.nodes
     dim, n = x.shape
+    if _state_holds(x, t, scalars, nodes):
+        return
     if WITH_WAVES:
         node_kinematics(x, t, scalars, sea.comps, nodes[WORK:WORK + NODE_ROWS], nodes[ETA:AZ + 1])
     else:
@@ -267,6 +285,11 @@ def water_state(x, p, t):
             points = p.junctions
             for k in range(points.nodes.shape[0]):
                 _live_added(points.added, k, points.nodes[k], nodes)
+    for i in range(n):
+        for a in range(dim):
+            nodes[AT_X + a, i] = x[a, i]
+    scalars[STATE_TIME] = t
+    scalars[STATE_VALID] = 1.0
 
 
 @jit.kernel(inline="always")
