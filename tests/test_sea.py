@@ -342,3 +342,44 @@ def test_the_run_time_estimate_counts_the_waves():
     still, slow, fast = (estimate(s).seconds for s in (base, direct, spectrum))
     assert still < fast < slow
     assert (slow - still) / (fast - still) == pytest.approx(36 / 2)   # the hose's [sea] is in all three
+
+
+def _moordyn_calc_sub_seg(a, b, surface, d):
+    """MoorDyn 2.7's Line::calcSubSeg transcribed in its own frame (z up) with its vector algebra, for
+    :func:`test_moordyn_fraction_rule_is_moordyns`."""
+    a, b = np.array(a, float), np.array(b, float)
+    za, zb = a[2] - surface, b[2] - surface
+    if za <= 0 and zb < 0:
+        return 1.0
+    if za > 0 and zb > 0:
+        return 0.0
+    if za == -zb:
+        return 0.5
+    lower, upper = (a.copy(), b.copy()) if za < 0 else (b.copy(), a.copy())
+    lower[2] -= surface
+    upper[2] -= surface
+    axis = upper - lower
+    up = np.array([0.0, 0.0, 1.0])
+    normal = np.cross(axis, np.cross(up, axis))
+    if np.linalg.norm(normal) > 0:
+        normal = normal / np.linalg.norm(normal) * d / 2
+    lower, upper = lower - normal, upper + normal
+    return abs(lower[2]) / (abs(lower[2]) + upper[2])
+
+
+def test_moordyn_fraction_rule_is_moordyns():
+    """``[sea] fraction = "moordyn"``: each segment's fraction as MoorDyn's calcSubSeg computes it (transcribed
+    above with its cross products, in its z-up frame), for segments of every slope and heading across a
+    surface, wholly in and out of the water, and vertical, to round-off."""
+    from ropesim.model.forces.sea import moordyn_segment_fraction
+
+    rng = np.random.default_rng(7)
+    d, surface = 0.3, 0.4
+    for _ in range(400):
+        a = rng.uniform(-2, 2, 3)
+        b = a + rng.normal(size=3) * rng.choice([0.1, 1.0, 3.0])
+        if rng.random() < 0.1:
+            b[:2] = a[:2]                         # vertical
+        x = np.array([[a[0], b[0]], [a[2], b[2]], [-a[1], -b[1]]])   # MoorDyn (x, y, z) -> ropesim (x, z, -y)
+        ours = moordyn_segment_fraction(x, 0, 1, surface, d / 2)
+        assert ours == pytest.approx(_moordyn_calc_sub_seg(a, b, surface, d), abs=1e-12)
