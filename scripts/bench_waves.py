@@ -161,7 +161,7 @@ def chain_target(window: float, repeats: int, hours: float, step: str | None = N
             t_end = 3600.0 * hours
             _, wall, _ = fairlead_tension(chain_in_a_sea(fastest[0], fastest[1], t_end))
             console.print(f"{hours:g} h of that sea, whole: {wall:.1f} s of CPU time, {t_end / wall:.0f}x real time")
-    console.print(per_node_step(repeats))
+    console.print(per_node_step(repeats, sweep_seconds))
     console.print(load_note())
 
 
