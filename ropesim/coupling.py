@@ -338,7 +338,7 @@ class Coupling:
         frame; a [flow] current is added on top) and the surface's elevation above the sea's level [m] there (N;
         default 0, the mean level), used by every force evaluation until the next call, in place of the scene's own
         ``[waves]`` (module doc)."""
-        from .model.forces.sea import GIVEN, GIVEN_WAVES
+        from .model.forces.sea import GIVEN, GIVEN_WAVES, STATE_VALID
 
         self._need_sea("set_waves")
         n, dim = self.model.nodes, self.model.dim
@@ -351,6 +351,7 @@ class Coupling:
         given[1:1 + dim] = self.frame.into(u).T
         given[4:4 + dim] = self.frame.into(a).T
         sea.scalars[GIVEN_WAVES] = 1.0
+        sea.scalars[STATE_VALID] = 0.0     # the water's state of the last evaluation is stale
 
     def _need_sea(self, call: str) -> None:
         if not self._has_sea():
@@ -411,11 +412,12 @@ class Coupling:
             np.copyto(m.bodies.accel, state["coupling_body_pose0"])
             np.copyto(m.bodies.base, state["coupling_body_base"])
         if self._has_sea() and "coupling_waves" in state:
-            from .model.forces.sea import GIVEN, GIVEN_WAVES
+            from .model.forces.sea import GIVEN, GIVEN_WAVES, STATE_VALID
 
             sea = self.model.params.sea
             np.copyto(sea.nodes[GIVEN:GIVEN + 7], state["coupling_waves"])
             sea.scalars[GIVEN_WAVES] = float(state["coupling_waves_given"])
+            sea.scalars[STATE_VALID] = 0.0
         self.integrator.restore({k: v for k, v in state.items() if k not in self.COUPLING_STATE})
 
     def checkpoint(self) -> None:

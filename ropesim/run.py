@@ -187,6 +187,13 @@ def _blow_up_message(model: Model, integrator: Integrator, code: int, node: int)
 NS_PER_NODE_STEP = {"symplectic_euler": 4.2, "verlet": 6.2, "yoshida4": 19.0, "pefrl": 20.0, "rk4": 180.0,
                     "sdirk2": 1100.0}
 NS_PER_NODE_FRAME = 150.0
+# What a [sea] adds per node and force evaluation [ns]: the surface, fractions and split drag, then each wave
+# component, advanced by a multiplication for a spectrum, evaluated directly for a table or a regular wave
+# (scripts/bench_waves.py), times the evaluations a step makes (sdirk2's measured on the mooring chain in a sea:
+# 4 to 5; the splitting schemes' velocity kicks take four sub-stages).
+NS_PER_NODE_SEA = 100.0
+NS_PER_NODE_COMPONENT = {"recurrence": 2.0, "direct": 36.0}
+SEA_EVALUATIONS_PER_STEP = {"sdirk2": 5.0}
 WARN_BYTES = 2 * 10 ** 9        # `run` and `check` warn above this much output
 WARN_SECONDS = 15 * 60          # ... or this long a run
 
@@ -208,9 +215,23 @@ def estimate(scene: Scene, model: Model | None = None) -> Estimate:
     grid = TimeGrid.of(scene)
     row = 8 * sum(int(np.prod(s, dtype=np.int64)) for s in frame_specs(model).values())
     total = grid.frames * row
-    cost = NS_PER_NODE_STEP.get(scene.integrator.method, max(NS_PER_NODE_STEP.values()))
+    cost = NS_PER_NODE_STEP.get(scene.integrator.method, max(NS_PER_NODE_STEP.values())) + _sea_cost(scene)
     seconds = 1e-9 * model.nodes * (grid.steps * cost + grid.frames * NS_PER_NODE_FRAME)
     return Estimate(frames=grid.frames, bytes=total, peak_bytes=2 * total, seconds=seconds)
+
+
+def _sea_cost(scene: Scene) -> float:
+    """What a scene's [sea] and [waves] add to a step's cost per node [ns] (see NS_PER_NODE_SEA)."""
+    if scene.sea is None:
+        return 0.0
+    per_evaluation = NS_PER_NODE_SEA
+    if scene.waves is not None:
+        from .model.waves import components_of, water_depth
+
+        comps = components_of(scene.waves, water_depth(scene), scene.gravity.g)
+        way = "recurrence" if comps.spacing is not None else "direct"
+        per_evaluation += comps.count * NS_PER_NODE_COMPONENT[way]
+    return SEA_EVALUATIONS_PER_STEP.get(scene.integrator.method, 4.0) * per_evaluation
 
 
 CHECKPOINT_SECONDS = 5.0   # a run folder commits a checkpoint at most this often (and at every stop)

@@ -227,6 +227,11 @@ def test_sea_and_waves_keys_refused_with_one_line(tmp_path):
         "[waves]\nkind = \"regular\"\nheight = 1.0\nperiod = 5.0\nseed = 3\n": "waves.seed",
         "[waves]\nkind = \"swell\"\n": "waves.kind",
         "[viscous_drag]\nb_normal = 1.0\nb_tangential = 0.1\n": "viscous_drag",
+        "[drag]\nb = 0.1\n": "drag",
+        "[waves]\nkind = \"jonswap\"\nsignificant_height = 2.0\npeak_period = -8.0\n": "waves.peak_period",
+        "[waves]\nkind = \"jonswap\"\nsignificant_height = 12.0\npeak_period = 3.0\n": "waves.significant_height",
+        "[waves]\nkind = \"table\"\ntable = [[0.5, 1.0, 0.0]]\n": "waves.table",
+        "[waves]\nkind = \"regular\"\nheight = 1.0\nperiod = 5.0\nstretching = \"linear\"\n": "waves.stretching",
     }
     (tmp_path / "comps.csv").write_text("amplitude,frequency,phase\n0.5,1.0,0\n")
     for extra, key in cases.items():
@@ -309,3 +314,72 @@ def test_the_viewer_draws_the_sea():
         expect = -1.0 + field.elevation(water.x[:, None], content.t[frame], water.z[None, :])
         assert np.allclose(water.heights[[frame]][0], expect, rtol=0, atol=1e-12)
     assert np.ptp(water.heights[[3]]) > 0.4
+
+
+def test_check_names_the_sea_and_its_waves(tmp_path):
+    """`ropesim check` lists the sea among the force terms: level, depth, air, the waves' kind and figures (the
+    regular wave's length from the dispersion relation), stretching and ramp."""
+    path = tmp_path / "s.toml"
+    path.write_text(hose(4.0, extra="[waves]\nkind = \"regular\"\nheight = 1.0\nperiod = 5.0\nramp_time = 10.0\n"))
+    out = subprocess.run([sys.executable, "-m", "ropesim", "check", str(path)], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    text = " ".join(out.stdout.replace("│", " ").split())
+    length = 2 * math.pi * G / (2 * math.pi / 5.0) ** 2   # deep water: the hose's sea has no seabed
+    assert "sea (level y = 0 m, deep water, air 1.225 kg/m^3)" in text
+    assert f"regular waves H = 1 m, T = 5 s (L = {length:.4g} m), wheeler stretching, ramped over 10 s" in text
+
+
+def test_the_run_time_estimate_counts_the_waves():
+    """The estimate adds the sea's cost per node and evaluation, and each component's: a table of 200 is
+    evaluated directly, a spectrum of 200 by the recurrence (scripts/bench_waves.py measures both)."""
+    from ropesim.run import estimate
+
+    base = ropesim.scene_from_toml(hose(4.0))
+    table = "\n".join(f"  [0.01, {0.5 + 0.01 * j}, 0.0, 0.0]," for j in range(200))
+    direct = ropesim.scene_from_toml(hose(4.0, extra=f"[waves]\nkind = \"table\"\ntable = [\n{table}\n]\n"))
+    spectrum = ropesim.scene_from_toml(hose(4.0, extra="[waves]\nkind = \"jonswap\"\nsignificant_height = 1.0\n"
+                                                       "peak_period = 8.0\ncomponents = 200\n"))
+    still, slow, fast = (estimate(s).seconds for s in (base, direct, spectrum))
+    assert still < fast < slow
+    assert (slow - still) / (fast - still) == pytest.approx(36 / 2)   # the hose's [sea] is in all three
+
+
+def _moordyn_calc_sub_seg(a, b, surface, d):
+    """MoorDyn 2.7's Line::calcSubSeg transcribed in its own frame (z up) with its vector algebra, for
+    :func:`test_moordyn_fraction_rule_is_moordyns`."""
+    a, b = np.array(a, float), np.array(b, float)
+    za, zb = a[2] - surface, b[2] - surface
+    if za <= 0 and zb < 0:
+        return 1.0
+    if za > 0 and zb > 0:
+        return 0.0
+    if za == -zb:
+        return 0.5
+    lower, upper = (a.copy(), b.copy()) if za < 0 else (b.copy(), a.copy())
+    lower[2] -= surface
+    upper[2] -= surface
+    axis = upper - lower
+    up = np.array([0.0, 0.0, 1.0])
+    normal = np.cross(axis, np.cross(up, axis))
+    if np.linalg.norm(normal) > 0:
+        normal = normal / np.linalg.norm(normal) * d / 2
+    lower, upper = lower - normal, upper + normal
+    return abs(lower[2]) / (abs(lower[2]) + upper[2])
+
+
+def test_moordyn_fraction_rule_is_moordyns():
+    """``[sea] fraction = "moordyn"``: each segment's fraction as MoorDyn's calcSubSeg computes it (transcribed
+    above with its cross products, in its z-up frame), for segments of every slope and heading across a
+    surface, wholly in and out of the water, and vertical, to round-off."""
+    from ropesim.model.forces.sea import moordyn_segment_fraction
+
+    rng = np.random.default_rng(7)
+    d, surface = 0.3, 0.4
+    for _ in range(400):
+        a = rng.uniform(-2, 2, 3)
+        b = a + rng.normal(size=3) * rng.choice([0.1, 1.0, 3.0])
+        if rng.random() < 0.1:
+            b[:2] = a[:2]                         # vertical
+        x = np.array([[a[0], b[0]], [a[2], b[2]], [-a[1], -b[1]]])   # MoorDyn (x, y, z) -> ropesim (x, z, -y)
+        ours = moordyn_segment_fraction(x, 0, 1, surface, d / 2)
+        assert ours == pytest.approx(_moordyn_calc_sub_seg(a, b, surface, d), abs=1e-12)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from pathlib import Path
 
 from rich import box
@@ -339,7 +341,37 @@ def force_terms(scene: Scene, model) -> list[str]:
         terms.append(f"{len(scene.bodies)} bod{'ies' if len(scene.bodies) > 1 else 'y'}")
     if scene.seabed:
         terms.append(_seabed_text(scene.seabed))
+    if scene.sea:
+        terms.append(_sea_text(scene))
     return terms
+
+
+def _sea_text(scene) -> str:
+    """The sea in one phrase: its level, depth, air and wind, the waves' kind and figures, stretching, ramp."""
+    from ..model.waves import DEEP, components_of, water_depth
+
+    sea, waves = scene.sea, scene.waves
+    depth = water_depth(scene)
+    where = f"level y = {sea.level:g} m, " + ("deep water" if depth == DEEP else f"{depth:g} m deep")
+    air = f", air {sea.air_density:g} kg/m^3" + (f", wind {list(sea.wind)} m/s" if sea.wind is not None else "")
+    rule = ", MoorDyn's submerged fraction" if sea.fraction == "moordyn" else ""
+    text = f"sea ({where}{air}{rule})"
+    if waves is None:
+        return text + ", still"
+    comps = components_of(waves, depth, scene.gravity.g)
+    if waves.kind == "regular":
+        length = 2.0 * math.pi / comps.k[0]
+        what = f"regular waves H = {waves.height:g} m, T = {waves.period:g} s (L = {length:.4g} m)"
+    elif waves.kind == "table":
+        what = f"{comps.count} wave component{'s' * (comps.count > 1)} from a table"
+    else:
+        name = "JONSWAP" if waves.kind == "jonswap" else "Pierson-Moskowitz"
+        gamma = f", gamma {waves.gamma:.3g}" if waves.kind == "jonswap" else ""
+        what = (f"{name} waves Hs = {waves.significant_height:g} m, Tp = {waves.peak_period:g} s{gamma}, "
+                f"{comps.count} components, seed {waves.seed}")
+    heading = f", heading {waves.direction:g} deg" if waves.direction else ""
+    ramp = f", ramped over {waves.ramp_time:g} s" if waves.ramp_time else ""
+    return f"{text}, {what}{heading}, {waves.stretching} stretching{ramp}"
 
 
 def _line_value(model, key: str, name: str, unit: str) -> str:

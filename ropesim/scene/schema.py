@@ -273,8 +273,8 @@ class Sea:
     of the line's diameter cut by the surface (a floating line rests at Archimedes' draught); a point body, a
     sphere of its volume. The part in air feels drag with the air's density on its velocity relative to the
     ``wind``, and no buoyancy. A ``[flow]`` is the current in the water. ``[waves]`` move the surface; without
-    them the water is still. Not combined with a sea (yet): ``[drag]``, ``[viscous_drag]`` and free rigid
-    bodies."""
+    them the water is still. Not combined with a sea: ``[drag]`` and ``[viscous_drag]`` (a linear coefficient has
+    no fluid property to carry from water to air), and (yet) free rigid bodies."""
 
     level: float = spec("float", "height y of the mean water level", "m", default=0.0)
     depth: float | None = spec("float", "water depth the waves feel (default: level - seabed.height; without a "
@@ -287,6 +287,9 @@ class Sea:
     probes: tuple | None = spec("horizontal", "wave probes: where to record the surface's elevation every frame, "
                                           "each a horizontal position (2-D: x; 3-D: x and the other horizontal "
                                           "axis)", "m", default=None, required=False)
+    fraction: str = spec("str", "a node's submerged part: cylinders (its half segments cut by the surface at "
+                                "the node, exact) or moordyn (MoorDyn 2's rule, for comparing with it)",
+                         default="cylinders", choices=("cylinders", "moordyn"))
 
 
 WAVE_KINDS = ("regular", "jonswap", "pierson_moskowitz", "table")

@@ -24,10 +24,11 @@ DEFAULTS = {"phase": 0.0, "seed": 0, "direction": 0.0}   # keys with a schema de
 TABLE_COLUMNS = ("amplitude", "frequency", "phase", "direction")
 DEFAULT_COMPONENTS = 100
 NOT_WITH_A_SEA = {
-    "drag": "[drag] is linear drag in one fluid everywhere; with a [sea] (water below the surface, air above) use "
-            "[fluid_drag]",
-    "viscous_drag": "[viscous_drag] is linear drag in one fluid everywhere; with a [sea] (water below the surface, "
-                    "air above) use [fluid_drag]",
+    "drag": "[drag] is one linear coefficient with no fluid property in it, so nothing says how it changes from "
+            "the water below a [sea]'s surface to the air above; use [fluid_drag], which the surface splits",
+    "viscous_drag": "[viscous_drag] is one linear coefficient with no fluid property in it, so nothing says how it "
+                    "changes from the water below a [sea]'s surface to the air above; use [fluid_drag], which "
+                    "the surface splits",
 }
 
 

@@ -14,6 +14,9 @@ at Archimedes' draught), a vertical one the fraction of its axis below the surfa
 continuous, as the stiff integrator's Newton solve needs. The node's line fraction f is the mean of its half
 segments' weighted by their unstretched lengths. A point body (a rope's ``[[bodies]]``, a system's free point
 with a volume) is a sphere of its volume: f_b = (u + 1)^2 (2 - u) / 4, u = (surface - y) / R.
+``[sea] fraction = "moordyn"`` puts MoorDyn 2's rule in place of the line's cylinders, to compare with it on
+equal physics (:func:`moordyn_line_fraction`): each segment's share below the mean of its two nodes' surface
+heights, measured along a diagonal of the segment; the Newton matrix keeps the cylinders' slope.
 
 **What acts on it**, with f and f_b at the state and time of every force evaluation:
 
@@ -44,7 +47,8 @@ term's too, on the submerged part (the :mod:`~ropesim.model.forces.flow_inertia`
 :func:`water_state` computes every node's surface elevation, fractions and water kinematics for positions x at
 time t into the bundle's state rows, at every force evaluation and before every Newton matrix (the time
 factors of the waves are shared by every evaluation at one time, :func:`ropesim.model.waves.time_factors`).
-The numbers depend on (x, t) alone.
+The numbers depend on (x, t) alone, so a call at the last call's positions and time returns at once (sdirk2's
+Newton matrix asks at the stage's (x, t) its residual has just asked at).
 
 The Newton matrix (sdirk2) gets the drag's damping on both parts (fractions and tangent frozen) and the
 buoyancy's vertical stiffness at the surface, -m lift df/dy (:func:`add_sea_jacobian`); the stability bound the
@@ -79,13 +83,15 @@ WITH_WAVES = jit.Switch("waves", "waves on the sea")
 Sea = namedtuple("Sea", ["scalars", "comps", "nodes"])
 
 # the surface's scalars, after the waves'; GIVEN_WAVES: 1 when the waves' kinematics come from outside
-AIR_RATIO, WIND_X, WIND_Y, WIND_Z, GIVEN_WAVES = range(WAVE_SCALARS, WAVE_SCALARS + 5)
-SCALAR_COUNT = WAVE_SCALARS + 5
+(AIR_RATIO, WIND_X, WIND_Y, WIND_Z, FRACTION_RULE, STATE_TIME, STATE_VALID,
+ GIVEN_WAVES) = range(WAVE_SCALARS, WAVE_SCALARS + 8)
+SCALAR_COUNT = WAVE_SCALARS + 8
+CYLINDERS, MOORDYN_RULE = 0.0, 1.0   # FRACTION_RULE: ``[sea] fraction``
 
 # per-node rows of Sea.nodes: constants, then the state of the last evaluation, then scratch
 (LIFT_LINE, LIFT_BODY, RADIUS, SPHERE, KN, KT, KB, AN, AT, AB, OWNED, HALF_LO, HALF_HI,
- ETA, UX, UY, UZ, AX, AY, AZ, F_LINE, F_BODY) = range(22)
-WORK = 22
+ ETA, UX, UY, UZ, AX, AY, AZ, F_LINE, F_BODY, AT_X, AT_Y, AT_Z) = range(25)
+WORK = 25
 GIVEN = WORK + NODE_ROWS     # 7 rows as ETA to AZ: the kinematics given from outside
 NODE_STATE_ROWS = GIVEN + 7
 
@@ -167,6 +173,52 @@ def line_fraction(x, i, around, surface, nodes):
 
 
 @jit.kernel(inline="always")
+def moordyn_segment_fraction(x, i, j, surface, r):
+    """MoorDyn 2's submerged fraction of the segment from node i to node j (i < j) under the plane y =
+    ``surface`` (its ``Line::calcSubSeg``, branch for branch): 1 or 0 with both ends below or above, 1/2 with
+    the ends at opposite heights, else the share below the surface of the diagonal from the lower end's
+    underside to the upper end's top side, each end moved by r cos(alpha) across the axis."""
+    dim = x.shape[0]
+    z_i, z_j = x[1, i] - surface, x[1, j] - surface
+    if z_i <= 0.0 and z_j < 0.0:
+        return 1.0
+    if z_i > 0.0 and z_j > 0.0:
+        return 0.0
+    if z_i == -z_j:
+        return 0.5
+    lower, upper = (z_i, z_j) if z_i < 0.0 else (z_j, z_i)
+    dx = x[0, j] - x[0, i]
+    dy = x[1, j] - x[1, i]
+    dz = x[2, j] - x[2, i] if dim == 3 else 0.0
+    flat = math.sqrt(dx * dx + dz * dz)
+    length = math.sqrt(flat * flat + dy * dy)
+    shift = r * flat / length if length > 0.0 else 0.0   # the vertical part of r times the up-most normal
+    lower -= shift
+    upper += shift
+    return abs(lower) / (abs(lower) + upper)
+
+
+@jit.kernel(inline="always")
+def moordyn_line_fraction(x, i, around, level, nodes):
+    """Node i's submerged fraction by MoorDyn 2's rule: its half segments weighted by their unstretched lengths,
+    each segment's fraction (:func:`moordyn_segment_fraction`) under the mean of its two nodes' surface heights
+    (MoorDyn's ``Line::getStateDeriv``); 1 on a node without a line volume."""
+    w_lo, w_hi = nodes[HALF_LO, i], nodes[HALF_HI, i]
+    total = w_lo + w_hi
+    r = nodes[RADIUS, i]
+    if total == 0.0 or r == 0.0:
+        return 1.0
+    f = 0.0
+    for side in range(2):
+        w = w_lo if side == 0 else w_hi
+        if w > 0.0:
+            j = around[side, i]
+            surface = level + 0.5 * (nodes[ETA, i] + nodes[ETA, j])
+            f += w * moordyn_segment_fraction(x, min(i, j), max(i, j), surface, r)
+    return f / total
+
+
+@jit.kernel(inline="always")
 def sphere_fraction(y, surface, radius):
     """(fraction, its derivative by y) of a sphere of ``radius`` centred at height y below ``surface``."""
     u = (surface - y) / radius
@@ -180,13 +232,30 @@ def sphere_fraction(y, surface, radius):
 # --------------------------------------------------------------------------------------- the state
 
 
+@jit.kernel(inline="always")
+def _state_holds(x, t, scalars, nodes):
+    """True when the state rows already hold positions x at time t (the last call's, stored in AT_X..AT_Z)."""
+    if scalars[STATE_VALID] != 1.0 or scalars[STATE_TIME] != t:
+        return False
+    dim, n = x.shape
+    for i in range(n):
+        for a in range(dim):
+            if nodes[AT_X + a, i] != x[a, i]:
+                return False
+    return True
+
+
 @jit.kernel
 def water_state(x, p, t):
     """Every node's surface elevation, submerged fractions, the water's velocity and acceleration at positions x
-    (D, N) and time t [s] into the sea's state rows (module doc)."""
+    (D, N) and time t [s] into the sea's state rows (module doc). A call at the positions and time of the last
+    returns at once: they depend on (x, t) alone, and sdirk2 asks for them at the same (x, t) for a stage's
+    residual and for its Newton matrix."""
     sea = p.sea
     scalars, nodes = sea.scalars, sea.nodes
     dim, n = x.shape
+    if _state_holds(x, t, scalars, nodes):
+        return
     if scalars[GIVEN_WAVES] != 0.0:
         for r in range(7):
             for i in range(n):
@@ -211,9 +280,13 @@ def water_state(x, p, t):
                 nodes[AY, i] += a1
                 nodes[AZ, i] += a2
     level = scalars[LEVEL]
+    moordyn = scalars[FRACTION_RULE] == MOORDYN_RULE
     for i in range(n):
         surface = level + nodes[ETA, i]
-        nodes[F_LINE, i] = line_fraction(x, i, p.neighbours, surface, nodes)[0]
+        if moordyn:
+            nodes[F_LINE, i] = moordyn_line_fraction(x, i, p.neighbours, level, nodes)
+        else:
+            nodes[F_LINE, i] = line_fraction(x, i, p.neighbours, surface, nodes)[0]
         nodes[F_BODY, i] = sphere_fraction(x[1, i], surface, nodes[SPHERE, i])[0] if nodes[SPHERE, i] > 0.0 else 1.0
     if WITH_ADDED_MASS:
         for i in range(n):
@@ -223,6 +296,11 @@ def water_state(x, p, t):
             points = p.junctions
             for k in range(points.nodes.shape[0]):
                 _live_added(points.added, k, points.nodes[k], nodes)
+    for i in range(n):
+        for a in range(dim):
+            nodes[AT_X + a, i] = x[a, i]
+    scalars[STATE_TIME] = t
+    scalars[STATE_VALID] = 1.0
 
 
 @jit.kernel(inline="always")
@@ -426,6 +504,7 @@ def _params(scene, layout) -> Sea:
     scalars[AIR_RATIO] = scene.sea.air_density / scene.fluid.density
     if scene.sea.wind is not None:
         scalars[WIND_X:WIND_X + scene.dimension] = scene.sea.wind
+    scalars[FRACTION_RULE] = MOORDYN_RULE if scene.sea.fraction == "moordyn" else CYLINDERS
     return Sea(scalars, comps, sea_nodes(scene, layout))
 
 
