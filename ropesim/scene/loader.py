@@ -334,6 +334,10 @@ def _check_system(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
         raise SceneError(source, key, message)
 
     _check_name_and_length(scene, fail)
+    _check_integrator(scene, fail)
+    if scene.integrator.method == "galpha" and any(b.kind == "free" for b in scene.rigid_bodies):
+        fail("integrator.method", "galpha does not move free rigid bodies yet; a system with a free body runs "
+                                  "with sdirk2, rk4 or a splitting scheme")
     scene = resolve_system(scene, base_dir, fail)
     _check_fluid(scene, fail)
     _check_flow_covers_the_start(scene, fail)
@@ -347,6 +351,7 @@ def _check_scene(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
         raise SceneError(source, key, message)
 
     _check_name_and_length(scene, fail)
+    _check_integrator(scene, fail)
     _check_topology(scene, fail)
     _check_nodes(scene, fail)
     _check_fluid(scene, fail)
@@ -356,6 +361,12 @@ def _check_scene(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
     _check_flow_covers_the_start(scene, fail)
     _check_seabed(scene, fail)
     return resolve_sea(scene, base_dir, fail)
+
+
+def _check_integrator(scene: S.Scene, fail) -> None:
+    if scene.integrator.rho_inf is not None and scene.integrator.method != "galpha":
+        fail("integrator.rho_inf", f"is generalized-alpha's (method = \"galpha\"); method "
+                                   f"{scene.integrator.method} has no rho_inf")
 
 
 def _resolve_driven(scene: S.Scene, base_dir: Path, fail) -> S.Scene:

@@ -801,7 +801,10 @@ class Integrator:
     dt: float = spec("float", "time step", "s", low=0, open_low=True)
     t_end: float = spec("float", "end time", "s", low=0)
     method: str = spec("str", "integration method", default="symplectic_euler",
-                       choices=("symplectic_euler", "verlet", "yoshida4", "pefrl", "rk4", "sdirk2"))
+                       choices=("symplectic_euler", "verlet", "yoshida4", "pefrl", "rk4", "sdirk2", "galpha"))
+    rho_inf: float | None = spec("float", "galpha's spectral radius at infinite step: 1 keeps every mode's "
+                                 "energy, 0 damps the highest out in one step (default 0.9)", default=None,
+                                 required=False, low=0, high=1)
 
 
 @dataclass(frozen=True)
