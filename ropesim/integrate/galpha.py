@@ -52,12 +52,16 @@ from ..model.terms import (WITH_ADDED_MASS, WITH_APPLIED, accelerations, applied
                            newton_matrix, solve_accelerations)
 from .base import Integrator, Method
 from .health import BOX, DRAG, FLUID, HELD, INTERNAL, NEWTON_FAILED, OK, SEABED, due, end_step, held_power, place, power
+from .galpha_adaptive import (ACCEPTED, EST_MAX, EST_SUM, H_MAX, H_MIN, H_NEXT, NEWTON_FRACTION, NEWTON_SHRINK,
+                              REJECTED, RTOL, SMALLEST, T0, T1, TOL, LIMITING, WITH_ADAPTIVE, dense_output, error_ratio,
+                              new_adapt, next_step, raw_error)
 from .sdirk import take_back_half, take_update
 
 DEFAULT_RHO_INF = 0.9
 NEWTON_TOL = 1e-11       # on the largest position update, times the shortest segment (as SDIRK2's)
 NEWTON_MAX_ITER = 60     # residual evaluations per step, halvings included
 RATE_REFACTOR = 0.25     # an update larger than this times the one before it: factor the matrix again
+REUSE_WITHIN = 0.25      # a matrix factored for a step within this fraction of the step is reused
 BACKTRACK_ABOVE = 1e3    # halve an update that raised the residual, unless it was within this many tolerances
 MAX_HALVINGS = 8
 
@@ -170,6 +174,33 @@ class GeneralizedAlphaFamily(Integrator):
         for name, array in self.matrix.items():
             setattr(self, name, array)
         self.STATE = ("acc_n", "stats", "control", "powers", *self.matrix)
+        self.adapt = None
+        tol = scene.integrator.tolerance
+        if tol is not None:   # the scheme's own steps; x, v on the grid by dense output
+            rtol = scene.integrator.relative_tolerance or 0.0
+            self.adapt = new_adapt(self.x, self.v, self.ledger, grid.dt, tol, rtol)
+            self.newton = self.newton._replace(tol=max(self.newton.tol, NEWTON_FRACTION * tol))
+            for name in self.adapt._fields:
+                setattr(self, f"adapt_{name}", getattr(self.adapt, name))
+            self.STATE += tuple(f"adapt_{name}" for name in self.adapt._fields)
+
+    @classmethod
+    def switches_for(cls, model, method) -> frozenset:
+        """The model's switches, and the adaptive steps' with a tolerance."""
+        adaptive = getattr(model.scene.integrator, "tolerance", None) is not None
+        return model.switches | ({WITH_ADAPTIVE.name} if adaptive else set())
+
+    def step_report(self) -> dict | None:
+        """What the adaptive steps did, for summary.json (None with fixed steps)."""
+        if self.adapt is None:
+            return None
+        clock, counts = self.adapt.clock, self.adapt.counts
+        return {"tolerance_m": float(clock[TOL]), "relative_tolerance": float(clock[RTOL]),
+                "steps_taken": int(counts[ACCEPTED]), "steps_rejected": int(counts[REJECTED]),
+                "estimated_error_m": float(clock[EST_SUM]), "largest_local_error_m": float(clock[EST_MAX]),
+                "smallest_step_s": float(clock[H_MIN]) if counts[ACCEPTED] else None,
+                "largest_step_s": float(clock[H_MAX]) if counts[ACCEPTED] else None,
+                "newton_iterations": int(self.stats[ITERATIONS]), "factorisations": int(self.stats[FACTORISATIONS])}
 
     @staticmethod
     def template():
@@ -187,7 +218,7 @@ class GeneralizedAlphaFamily(Integrator):
     def _run(self, n, frames):
         return self.loop((self.x, self.v, self.acc_n, self.ledger, self.stats, self.control, self.powers), self.work,
                          self.newton, self.coefficients, self.held, self.nodes, self.model.params, self.limits,
-                         self.schedule(n), frames, self.bodies)
+                         self.schedule(n), frames, self.bodies, self.adapt)
 
 
 @jit.kernel
@@ -331,7 +362,7 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats):
     band, rhs = newton.jac.band, newton.rhs
     p = band.shape[0] - 1
     place(X, V, held, t_f, t + 0.5 * h)
-    refactor = control[FACTORED_H] != h
+    refactor = control[FACTORED_H] == 0.0 or abs(h - control[FACTORED_H]) > REUSE_WITHIN * control[FACTORED_H]
     worst_node = -1
     last = np.inf
     stride = 0.0
@@ -429,10 +460,12 @@ def book(ledger, powers, control, co, h, work, fluid, internal, seabed, held, no
 
 
 @jit.kernel
-def advance_galpha(state, work, newton, co, held, nodes, params, limits, schedule, frames, bodies):
+def advance_galpha(state, work, newton, co, held, nodes, params, limits, schedule, frames, bodies, adapt):
     """Advance ``schedule.n_steps`` generalized-alpha steps in place; the contract of :mod:`ropesim.integrate.base`.
 
-    ``state`` = (x, v, a_n, ledger, stats, control, last powers). Returns (steps done, frames written, status, node)."""
+    ``state`` = (x, v, a_n, ledger, stats, control, last powers); ``adapt`` the adaptive steps' state
+    (:mod:`ropesim.integrate.galpha_adaptive`; None with fixed steps). Returns (steps done, frames written,
+    status, node)."""
     x, v, an, ledger, stats, control, powers = state
     h = schedule.h
     frame = np.int64(0)   # not the literal 0: Numba would compile the frame saving twice (for 0, then int64)
@@ -440,6 +473,9 @@ def advance_galpha(state, work, newton, co, held, nodes, params, limits, schedul
         start_acceleration(x, v, an, work.tmp, schedule.step0 * h, held, nodes, params)
         stats[ITERATIONS] += 1
         control[STARTED] = 1.0
+    if WITH_ADAPTIVE:
+        return advance_adaptive(state, work, newton, co, held, nodes, params, limits, schedule, frames, bodies,
+                                adapt)
     for s in range(schedule.n_steps):
         step = schedule.step0 + s
         t = step * h
@@ -452,6 +488,83 @@ def advance_galpha(state, work, newton, co, held, nodes, params, limits, schedul
         stats[STEPS] += 1
         place(x, v, held, (step + 1) * h, (step + 1) * h)
         done = step + 1
+        if not due(done, schedule):
+            continue
+        status, node, frame = end_step(done, schedule, x, v, nodes.mass, params, ledger, limits, frames, frame,
+                                       bodies)
+        if status != OK:
+            return s + 1, frame, status, node
+    return schedule.n_steps, frame, OK, -1
+
+
+@jit.kernel(inline="always")
+def filtered_error_ratio(work, an, co, h, x, newton, nodes, params, clock, share):
+    """The step's error estimate filtered by the factored Newton matrix, J^-1 M e (see
+    :mod:`ropesim.integrate.galpha_adaptive`), over its allowance; returns (ratio, the largest error [m], its
+    node)."""
+    band, rhs = newton.jac.band, newton.rhs
+    raw_error(work, an, co, h, nodes, rhs)
+    if WITH_JUNCTIONS:
+        fold_junctions(rhs, params.junctions, x.shape[0])
+        schur_solve(band, newton.jac.w, params.lines, newton.groups, rhs)
+    else:
+        solve(band, newton.jac.corner, newton.cyclic, band.shape[0] - 1, rhs, newton.wood)
+    return error_ratio(rhs, x, work.X, co[1], clock[TOL], clock[RTOL], nodes.free, share)
+
+
+@jit.kernel
+def advance_adaptive(state, work, newton, co, held, nodes, params, limits, schedule, frames, bodies, adapt):
+    """The grid steps ``schedule.step0`` + 1 ... + n_steps, each read off the scheme's own steps by dense output
+    (:mod:`ropesim.integrate.galpha_adaptive`); the internal steps chosen by the error estimate."""
+    x, v, an, ledger, stats, control, powers = state
+    x1, v1, clock, counts = adapt.x1, adapt.v1, adapt.clock, adapt.counts
+    free = nodes.free
+    t_end = schedule.total_steps * schedule.h
+    frame = np.int64(0)
+    for s in range(schedule.n_steps):
+        done = schedule.step0 + s + 1
+        target = done * schedule.h if done < schedule.total_steps else t_end
+        while clock[T1] < target * (1.0 - 1e-13):
+            t = clock[T1]
+            h = min(clock[H_NEXT], t_end - t)
+            while True:
+                if h < SMALLEST * t_end:
+                    return s, frame, NEWTON_FAILED, -1
+                step_start(x1, v1, an, work, co, h)
+                its, node, fluid, internal, seabed = solve_step(work, newton, co, t, h, held, nodes, params,
+                                                                control, stats)
+                if its < 0:
+                    counts[REJECTED] += 1
+                    h *= NEWTON_SHRINK
+                    continue
+                ratio, error, limiting = filtered_error_ratio(work, an, co, h, x1, newton, nodes, params, clock, h / t_end)
+                if ratio > 1.0:
+                    counts[REJECTED] += 1
+                    h = next_step(h, ratio)
+                    continue
+                break
+            for d in range(x1.shape[0]):
+                for i in range(x1.shape[1]):
+                    adapt.x0[d, i] = x1[d, i]
+                    adapt.v0[d, i] = v1[d, i]
+            for k in range(ledger.shape[0]):
+                adapt.ledger0[k] = adapt.ledger1[k]
+            book(adapt.ledger1, powers, control, co, h, work, fluid, internal, seabed, held, nodes, params)
+            step_end(x1, v1, an, work, co, h, free)
+            place(x1, v1, held, t + h, t + h)
+            stats[STEPS] += 1
+            counts[ACCEPTED] += 1
+            clock[T0] = t
+            clock[T1] = t + h
+            clock[EST_MAX] = max(clock[EST_MAX], error)
+            clock[EST_SUM] += error
+            clock[H_MIN] = min(clock[H_MIN], h)
+            clock[H_MAX] = max(clock[H_MAX], h)
+            clock[LIMITING] = limiting
+            if t + h < t_end:   # the last step, cut to reach t_end, says nothing of the next
+                clock[H_NEXT] = next_step(h, ratio)
+        dense_output(adapt, target, x, v, ledger)
+        place(x, v, held, target, target)
         if not due(done, schedule):
             continue
         status, node, frame = end_step(done, schedule, x, v, nodes.mass, params, ledger, limits, frames, frame,

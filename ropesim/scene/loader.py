@@ -364,9 +364,14 @@ def _check_scene(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
 
 
 def _check_integrator(scene: S.Scene, fail) -> None:
-    if scene.integrator.rho_inf is not None and scene.integrator.method != "galpha":
-        fail("integrator.rho_inf", f"is generalized-alpha's (method = \"galpha\"); method "
-                                   f"{scene.integrator.method} has no rho_inf")
+    """galpha's keys only with galpha (the other methods take fixed steps), and relative_tolerance only with
+    tolerance."""
+    method = scene.integrator.method
+    for key in ("rho_inf", "tolerance", "relative_tolerance"):
+        if getattr(scene.integrator, key) is not None and method != "galpha":
+            fail(f"integrator.{key}", f"is generalized-alpha's (method = \"galpha\"); method {method} has no {key}")
+    if scene.integrator.relative_tolerance is not None and scene.integrator.tolerance is None:
+        fail("integrator.relative_tolerance", "needs integrator.tolerance (the absolute part, in metres) too")
 
 
 def _resolve_driven(scene: S.Scene, base_dir: Path, fail) -> S.Scene:

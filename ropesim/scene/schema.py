@@ -805,6 +805,11 @@ class Integrator:
     rho_inf: float | None = spec("float", "galpha's spectral radius at infinite step: 1 keeps every mode's "
                                  "energy, 0 damps the highest out in one step (default 0.9)", default=None,
                                  required=False, low=0, high=1)
+    tolerance: float | None = spec("float", "galpha's error tolerance: adaptive steps, each step's estimated error "
+                                   "at most this; dt is then the grid x and v are reported on", "m", default=None,
+                                   required=False, low=0, open_low=True)
+    relative_tolerance: float | None = spec("float", "with tolerance: plus this fraction of the nodes' coordinates",
+                                            default=None, required=False, low=0)
 
 
 @dataclass(frozen=True)
