@@ -335,7 +335,8 @@ def factor_matrix(work, newton, c2, beta_v, t_f, nodes, params):
     band = newton.jac.band
     dim, n = X.shape
     s = math.sqrt(c2)
-    newton_matrix(X, V, newton.jac, s, nodes, params, t_f)
+    newton_matrix(X, V, newton.jac, s, (free, mass, drag), params, t_f)   # a plain tuple, as the static solve's:
+    # the same compiled copy serves both (a namedtuple is another type, and compiled it again: 2.5 s)
     for i in range(n):   # the linear drag's exact weight c2 / beta_v, not s
         if free[i]:
             for d in range(dim):
