@@ -93,12 +93,13 @@ def test_on_a_system_the_free_point_moves_as_one_and_the_order_is_two():
 
 def test_mooring_chain_at_a_tenth_of_a_second():
     """mooring_chain (seabed contact and friction, fluid drag, added mass, a surging fairlead) at dt = 0.1 s, 40
-    times rk4's stable step: Newton converges at every step, to 30 s, with the matrix factored on fewer than
-    three steps in four (modified Newton), and the chain stays within 0.1 m of rk4 at 1 ms. Without the
-    friction's exact slope (galpha.friction_slope) Newton stalled at t = 20 s."""
+    times rk4's stable step: Newton converges at every step, to 30 s (about 10 iterations and 2.5
+    factorisations a step, measured: the sliding seabed nodes make the matrix go stale within a step; asserted
+    below 4), and the chain stays within 0.1 m of rk4 at 2 ms. Without the friction's exact slope
+    (galpha.friction_slope) Newton stalled at t = 20 s."""
     scene = ropesim.load_scene(SCENARIOS / "mooring_chain.toml")
     it = advance(scene, "galpha", 0.1, 30.0)
-    assert it.factorisations < 0.75 * 300 * 10   # at most ten factorisations a step on average
+    assert it.factorisations < 4 * 300
     reference = advance(scene, "rk4", 0.002, 30.0).x
     assert np.abs(it.x - reference).max() < 0.1
 
