@@ -1,4 +1,4 @@
-"""Speed at equal accuracy on a mooring line: ropesim (verlet, rk4, sdirk2) against MoorDyn (RK2, RK4), and where
+"""Speed at equal accuracy on a mooring line: ropesim (verlet, rk4, sdirk2, galpha) against MoorDyn (RK2, RK4), and where
 ropesim's implicit sdirk2 overtakes its explicit methods as the chain gets stiffer.
 
 The case: MoorDyn's WD0050_Chain (tests/data/moordyn/cases/: 410 m of studless chain, 82 segments, EA = 1.674e9 N,
@@ -77,6 +77,8 @@ SWEEP_EA = (1e8, 3e8, 1e9, 3e9, 1e10, 1e11)
 SWEEP_WINDOW = 30.0
 #: ropesim's seabed damping: MoorDyn's two-way law (equal physics), or ropesim's own with --own-seabed
 SEABED = {"both_ways": True}
+#: galpha's rho_inf (None: its default), from --galpha-rho
+GALPHA = {"rho_inf": None}
 
 
 def step_of(k: int) -> float:
@@ -111,13 +113,19 @@ def problem(EA: float | None = None):
 
 
 def ropesim_run(case, start, method: str, dt: float, t_end: float) -> dict:
+    """One run; ``method`` "galpha tol=T" is galpha with adaptive steps at tolerance T [m] (dt its output grid)."""
     import tomli_w
 
     import ropesim
 
-    scene = chain_scene_dict(case, start, method=method, dt=dt, t_end=t_end, interval=DT_OUT, dimension=3,
+    name, _, tol = method.partition(" tol=")
+    scene = chain_scene_dict(case, start, method=name, dt=dt, t_end=t_end, interval=DT_OUT, dimension=3,
                              both_ways=SEABED["both_ways"],
                              surge=SURGE)
+    if tol:
+        scene["integrator"]["tolerance"] = float(tol)
+    if name == "galpha" and GALPHA["rho_inf"] is not None:
+        scene["integrator"]["rho_inf"] = GALPHA["rho_inf"]
     traj = ropesim.simulate(ropesim.scene_from_toml(tomli_w.dumps(scene)))
     ok = traj.summary["status"] == "completed"
     return {"fairlead": np.abs(np.asarray(traj.tension)[:, -1]) if ok else None, "wall": traj.summary["wall_time_s"],
@@ -180,6 +188,9 @@ def ladder(k0: int, count: int, factor: float = math.sqrt(2.0)) -> list[int]:
 
 #: sdirk2's steps, DT_OUT / k: dense, because its Newton solve may fail at some steps and not at others
 SDIRK_KS = (1, 2, 3, 4, 6, 8, 12, 16, 24, 32)
+#: galpha's fixed steps, DT_OUT / k, and its tolerances [m] with adaptive steps (reported on the DT_OUT grid)
+GALPHA_KS = (1, 2, 3, 4, 6, 8, 12, 16, 24, 32)
+GALPHA_TOLERANCES = (1.0, 0.3, 0.1, 0.03, 0.01, 0.003)
 
 
 def configurations(case, start, t_end: float, points: int, sdirk_ks=SDIRK_KS,
@@ -194,6 +205,8 @@ def configurations(case, start, t_end: float, points: int, sdirk_ks=SDIRK_KS,
         notes[f"ropesim {method}"] = {"bound_s": bound, "largest_stable_s": step_of(k0), "blew_up_at_s": failed}
         configs += [("ropesim", method, k) for k in ladder(k0, points)]
     configs += [("ropesim", "sdirk2", k) for k in sdirk_ks]
+    configs += [("ropesim", "galpha", k) for k in GALPHA_KS]
+    configs += [("ropesim", f"galpha tol={tol:g}", 1) for tol in GALPHA_TOLERANCES]
     rk4_bound = notes["ropesim rk4"]["bound_s"]
     for scheme, guess in (("RK2", rk4_bound), ("RK4", 1.5 * rk4_bound)) if moordyn else ():
         k0, failed = largest_stable(case, start, "MoorDyn", scheme, guess, short)
@@ -251,9 +264,9 @@ def cheapest(rows: list[dict], targets=TARGETS) -> dict:
         for row in rows:
             if not row["ok"] or row["error"] > target:
                 continue
-            key = f"{row['code']} {row['method']}"
+            key = f"{row['code']} {row['method'].split(' tol=')[0]}" + (" adaptive" if " tol=" in row["method"] else "")
             if key not in best or row["wall_per_s"] < best[key]["wall_per_s"]:
-                best[key] = {"dt_s": row["dt_s"], "wall_per_s": row["wall_per_s"], "error": row["error"],
+                best[key] = {"dt_s": row["dt_s"], "method": row["method"], "wall_per_s": row["wall_per_s"], "error": row["error"],
                              "sea_state_wall_s": row["wall_per_s"] * SEA_STATE,
                              "real_time_factor": row["real_time_factor"]}
         out[f"{target:g}"] = best
@@ -332,13 +345,16 @@ def speed_table(rows: list[dict]) -> str:
         if not r["ok"]:
             lines.append(f"| {r['code']} | {r['method']} | {r['dt_s'] * 1e3:.4g} ms | {r.get('status')} | | | |")
             continue
-        lines.append(f"| {r['code']} | {r['method']} | {r['dt_s'] * 1e3:.4g} ms | {r['wall_per_s'] * 1e3:.2f} ms | "
+        step = r["method"].split(" tol=")[1] + " m tolerance" if " tol=" in r["method"] else f"{r['dt_s'] * 1e3:.4g} ms"
+        lines.append(f"| {r['code']} | {r['method'].split(' tol=')[0]} | {step} | {r['wall_per_s'] * 1e3:.2f} ms | "
                      f"{r['real_time_factor']:.0f} | {r['error']:.2e} | {r['error_of_rms']:.2e} |")
     return "\n".join(lines)
 
 
 def target_table(best: dict) -> str:
-    keys = ["ropesim verlet", "ropesim rk4", "ropesim sdirk2", "MoorDyn RK2", "MoorDyn RK4"]
+    keys = ["ropesim verlet", "ropesim rk4", "ropesim sdirk2", "ropesim galpha", "ropesim galpha adaptive",
+            "MoorDyn RK2", "MoorDyn RK4"]
+    keys = [k for k in keys if any(k in per for per in best.values())]
     lines = ["| accuracy (RMS / range) | " + " | ".join(keys) + " | best ropesim / best MoorDyn |",
              "| --- |" + " --- |" * (len(keys) + 1)]
     for target, per in best.items():
@@ -347,8 +363,8 @@ def target_table(best: dict) -> str:
             b = per.get(k)
             cells.append(f"{b['wall_per_s'] * 1e3:.2f} ms/s at {b['dt_s'] * 1e3:.3g} ms: 3 h in "
                          f"{b['sea_state_wall_s']:.0f} s ({b['real_time_factor']:.0f}x real time)" if b else "not reached")
-        rs = [per[k]["wall_per_s"] for k in keys[:3] if k in per]
-        md = [per[k]["wall_per_s"] for k in keys[3:] if k in per]
+        rs = [per[k]["wall_per_s"] for k in keys if k in per and k.startswith("ropesim")]
+        md = [per[k]["wall_per_s"] for k in keys if k in per and k.startswith("MoorDyn")]
         ratio = f"{min(md) / min(rs):.2f}x faster" if rs and md else ""
         lines.append(f"| {float(target) * 100:g} % | " + " | ".join(cells) + f" | {ratio} |")
     return "\n".join(lines)
@@ -432,6 +448,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--window", type=float, default=120.0, help="simulated seconds of the main comparison")
     parser.add_argument("--points", type=int, default=4, help="steps per explicit method's ladder")
     parser.add_argument("--no-sweep", action="store_true", help="skip the EA sweep")
+    parser.add_argument("--only", help="comma-separated ropesim methods to time (default: all; MoorDyn always)")
+    parser.add_argument("--galpha-rho", type=float, help="galpha's rho_inf (default: its own, 0.9)")
     parser.add_argument("--own-seabed", action="store_true",
                         help="ropesim's own seabed damping (into the plane only) instead of MoorDyn's two-way law")
     parser.add_argument("--sweep-ea", default=",".join(f"{e:g}" for e in SWEEP_EA), help="EA values (N) to sweep")
@@ -439,6 +457,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--figure", type=Path, default=FIGURE, help="PNG of error against cost, and the sweep")
     args = parser.parse_args(argv)
     SEABED["both_ways"] = not args.own_seabed
+    GALPHA["rho_inf"] = args.galpha_rho
 
     from references.moordyn_harness import moordyn_version
 
@@ -455,6 +474,9 @@ def main(argv: list[str] | None = None) -> int:
     overhead = call_overhead(case, start, 20.0)
     print("ladders (largest stable steps) ...", flush=True)
     configs, notes = configurations(case, start, args.window, args.points)
+    if args.only:
+        keep = set(args.only.split(","))
+        configs = [c for c in configs if c[0] == "MoorDyn" or c[1].split(" tol=")[0] in keep]
     print(f"timing {len(configs)} configurations, {args.repeats} rounds ...", flush=True)
     rows = measure(case, start, configs, {"ropesim": ref, "MoorDyn": md_ref}, args.window, args.repeats,
                    overhead["per_call_us"] * 1e-6)

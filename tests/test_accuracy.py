@@ -38,6 +38,7 @@ LADDERS = {
     "pefrl": [0.016, 0.008, 0.004],
     "rk4": [0.016, 0.008, 0.004, 0.002],
     "sdirk2": [0.008, 0.004, 0.002, 0.001],
+    "galpha": [0.008, 0.004, 0.002, 0.001],
 }
 
 
@@ -124,7 +125,8 @@ def test_energy_error_in_a_vacuum_shrinks_at_the_methods_order(method):
     loses (h omega)^6 / 72 of a mode's energy per step, a fifth-order term that hides the fourth-order one
     until h omega is small).
     """
-    dts = {"pefrl": [0.004, 0.002, 0.001], "rk4": [5e-4, 2.5e-4, 1.25e-4], "sdirk2": [5e-4, 2.5e-4, 1.25e-4]}.get(
+    dts = {"pefrl": [0.004, 0.002, 0.001], "rk4": [5e-4, 2.5e-4, 1.25e-4], "sdirk2": [5e-4, 2.5e-4, 1.25e-4],
+            "galpha": [5e-4, 2.5e-4, 1.25e-4]}.get(
         method, [0.002, 0.001, 0.0005])
     errs = [energy_error(method, dt) for dt in dts]
     peaks = [e.max() for e in errs]

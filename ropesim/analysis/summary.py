@@ -74,6 +74,10 @@ def summarize(model: Model, outcome, t: np.ndarray, x: np.ndarray, v: np.ndarray
         "stable_dt_bound": _finite_or_none(predicted_dt(model, scene.integrator.method)),
         "force_evaluations": outcome.force_evaluations,
     }
+    report = getattr(getattr(outcome, "integrator", None), "step_report", None)
+    adaptive = report() if report is not None else None
+    if adaptive is not None:   # galpha with a tolerance: its own steps, and its error estimate
+        summary["adaptive_steps"] = adaptive
     if outcome.message:
         summary["message"] = outcome.message
     if grid.dt_adjusted:

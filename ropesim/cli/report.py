@@ -427,7 +427,7 @@ def stability_rows(model, method: str, dt: float) -> list[tuple[str, str]]:
     high = drag_rates(model)[1]
     if high > 0:
         out.append(("drag", f"b/m up to {high:.4g} 1/s: exact in the splitting schemes' kicks, explicit in rk4, "
-                            f"implicit in sdirk2"))
+                            f"implicit in sdirk2 and galpha"))
     sharp = [name for name, part in (("thrower", scene.thrower), *(("guides", g) for g in scene.guides))
              if part is not None and part.edge_width == 0]
     if sharp:
@@ -437,7 +437,8 @@ def stability_rows(model, method: str, dt: float) -> list[tuple[str, str]]:
     for b in rows:
         mark = "  <- this scene" if b.method == method else ""
         if b.dt_spectral == float("inf"):
-            out.append((f"  {b.method}", f"stable at any dt (L-stable implicit){mark}"))
+            kind = "L-stable implicit" if b.method == "sdirk2" else "implicit, high modes damped by rho_inf"
+            out.append((f"  {b.method}", f"stable at any dt ({kind}){mark}"))
             continue
         if dt > b.dt_spectral:
             verdict = "UNSTABLE: `ropesim run` refuses it without --force"

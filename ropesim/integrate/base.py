@@ -103,6 +103,7 @@ class Method:
     drag_explicit = False          # linear drag evaluated explicitly (it then limits the stable step)
     exact_contact_kicks = False    # the thrower's and guides' damping integrated exactly when their edges are smooth
     unconditionally_stable = False
+    starts_from_x_and_v = True     # a step needs x and v alone (generalized-alpha also carries an acceleration)
 
     @property
     def family(self) -> type:

@@ -7,11 +7,12 @@ Each entry is a :class:`~ropesim.integrate.base.Method` whose ``family`` runs it
 from __future__ import annotations
 
 from .base import Integrator
+from .galpha import GALPHA
 from .rk import RK4
 from .sdirk import SDIRK2
 from .splitting import SCHEMES
 
-METHODS: dict = {m.name: m for m in (*SCHEMES, RK4, SDIRK2)}
+METHODS: dict = {m.name: m for m in (*SCHEMES, RK4, SDIRK2, GALPHA)}
 
 
 def get_method(name: str):

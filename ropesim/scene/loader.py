@@ -334,6 +334,10 @@ def _check_system(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
         raise SceneError(source, key, message)
 
     _check_name_and_length(scene, fail)
+    _check_integrator(scene, fail)
+    if scene.integrator.method == "galpha" and any(b.kind == "free" for b in scene.rigid_bodies):
+        fail("integrator.method", "galpha does not move free rigid bodies yet; a system with a free body runs "
+                                  "with sdirk2, rk4 or a splitting scheme")
     scene = resolve_system(scene, base_dir, fail)
     _check_fluid(scene, fail)
     _check_flow_covers_the_start(scene, fail)
@@ -347,6 +351,7 @@ def _check_scene(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
         raise SceneError(source, key, message)
 
     _check_name_and_length(scene, fail)
+    _check_integrator(scene, fail)
     _check_topology(scene, fail)
     _check_nodes(scene, fail)
     _check_fluid(scene, fail)
@@ -356,6 +361,17 @@ def _check_scene(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
     _check_flow_covers_the_start(scene, fail)
     _check_seabed(scene, fail)
     return resolve_sea(scene, base_dir, fail)
+
+
+def _check_integrator(scene: S.Scene, fail) -> None:
+    """galpha's keys only with galpha (the other methods take fixed steps), and relative_tolerance only with
+    tolerance."""
+    method = scene.integrator.method
+    for key in ("rho_inf", "tolerance", "relative_tolerance"):
+        if getattr(scene.integrator, key) is not None and method != "galpha":
+            fail(f"integrator.{key}", f"is generalized-alpha's (method = \"galpha\"); method {method} has no {key}")
+    if scene.integrator.relative_tolerance is not None and scene.integrator.tolerance is None:
+        fail("integrator.relative_tolerance", "needs integrator.tolerance (the absolute part, in metres) too")
 
 
 def _resolve_driven(scene: S.Scene, base_dir: Path, fail) -> S.Scene:

@@ -1,0 +1,575 @@
+"""The structural integrator: generalized-alpha (Chung & Hulbert 1993), implicit, second order, with modified Newton.
+
+For M x'' = F(t, x, x') - b x' (b the linear drag; the added mass in M), one step from (x_n, v_n, a_n) solves
+
+    M a_(n+1-am) = F(t_(n+1-af), x_(n+1-af), v_(n+1-af)) - b v_(n+1-af),
+    x_(n+1) = x_n + h v_n + h^2 ((1/2 - beta) a_n + beta a_(n+1)),   v_(n+1) = v_n + h ((1 - gam) a_n + gam a_(n+1)),
+
+with y_(n+1-a) = (1 - a) y_(n+1) + a y_n. From the user's rho_inf (the spectral radius at h omega -> infinity,
+``integrator.rho_inf``, 0 <= rho_inf <= 1): am = (2 rho - 1) / (rho + 1), af = rho / (rho + 1), gam = 1/2 - am + af,
+beta = (1 - am + af)^2 / 4: second order, unconditionally stable, and the largest damping of the high modes for
+the least of the low ones. rho_inf = 1 is the trapezoidal rule (no numerical dissipation, energy kept to second
+order), rho_inf = 0 annihilates the highest modes in one step (asymptotic annihilation).
+
+The unknown is X = x_(n+1-af), the point where the forces are evaluated. Everything else is linear in it:
+V = v_(n+1-af) = Vk + (X - Xk) / beta_v with beta_v = beta h / gam, and the equation, times
+c2 = (1 - af) beta h^2 / (1 - am), reads M (X - Xa) = c2 (F(X, V) - b V) (Xk, Xa, Vk known from the step's start;
+:func:`step_start`). Newton's matrix is M + c2 K + (c2 / beta_v) (C + b), K and C the forces' stiffness and
+damping: the same block-banded shape as SDIRK2's M + s^2 K + s C (:mod:`ropesim.integrate.sdirk`), which is
+assembled with s = sqrt(c2): the stiffness is exact, the linear drag is corrected on the diagonal, and the other
+damping's weight is off by the factor gam sqrt((1 - af) / ((1 - am) beta)) (1 at rho_inf = 1, at most 1.06 at
+rho_inf = 0), which slows Newton's convergence by a few per cent and never changes its solution. Each line is
+banded and a system's points are joined by a Schur complement (:mod:`ropesim.model.schur`), as in SDIRK2.
+
+Modified Newton: the matrix is factored when the step size changes or when Newton converges slowly (an update
+not smaller than RATE_REFACTOR times the one before it), and is otherwise reused, across steps too. A full update
+that raises the residual (a contact switching on, a segment going slack) is halved (a backtracking line search).
+The non-smooth terms are not regularised beyond what the force terms already do (the seabed's onset and the
+friction have their own smoothing lengths, see the seabed's docs); compressive geometric stiffness is left out of
+the matrix as in SDIRK2.
+
+The energy ledger books each step's flows from their powers at this step's and the last step's force points,
+read off at the step's middle on the line through both (:func:`book`): second order for every rho_inf.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model import jit
+from ..model.banded import factor, solve, woodbury
+from ..model.forces.added_mass import added_mass_times
+from ..model.forces.seabed import WITH_SEABED, depth
+from ..model.jacobian import Jacobian, band_width
+from ..model.junctions import (WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_junctions,
+                               junction_added_mass_residual)
+from ..model.schur import model_groups, schur_factor, schur_solve
+from ..model.terms import (WITH_ADDED_MASS, WITH_APPLIED, accelerations, applied_accelerations, coupling_reach,
+                           newton_matrix, solve_accelerations)
+from .base import Integrator, Method
+from .health import BOX, DRAG, FLUID, HELD, INTERNAL, NEWTON_FAILED, OK, SEABED, due, end_step, held_power, place, power
+from .galpha_adaptive import (ACCEPTED, EST_MAX, EST_SUM, H_MAX, H_MIN, H_NEXT, NEWTON_FRACTION, NEWTON_SHRINK,
+                              REJECTED, RTOL, SMALLEST, T0, T1, TOL, LIMITING, WITH_ADAPTIVE, dense_output, error_ratio,
+                              new_adapt, next_step, raw_error)
+from .sdirk import take_back_half, take_update
+
+DEFAULT_RHO_INF = 0.9
+NEWTON_TOL = 1e-11       # on the largest position update, times the shortest segment (as SDIRK2's)
+NEWTON_MAX_ITER = 60     # residual evaluations per step, halvings included
+RATE_REFACTOR = 0.25     # an update larger than this times the one before it: factor the matrix again
+REUSE_WITHIN = 0.25      # a matrix factored for a step within this fraction of the step is reused
+BACKTRACK_ABOVE = 1e3    # halve an update that raised the residual, unless it was within this many tolerances
+MAX_HALVINGS = 8
+
+# the control array: the step the matrix was factored for (0: none), whether a_n holds the start's acceleration,
+# the last step (0: none)
+FACTORED_H, STARTED, LAST_H = 0, 1, 2
+# the statistics: Newton iterations, factorisations, steps taken
+ITERATIONS, FACTORISATIONS, STEPS = 0, 1, 2
+
+
+def coefficients(rho_inf: float) -> tuple[float, float, float, float]:
+    """(alpha_m, alpha_f, gamma, beta) of Chung & Hulbert's generalized-alpha for a spectral radius rho_inf."""
+    am = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0)
+    af = rho_inf / (rho_inf + 1.0)
+    gam = 0.5 - am + af
+    return am, af, gam, 0.25 * (1.0 - am + af) ** 2
+
+
+@dataclass(frozen=True)
+class GeneralizedAlpha(Method):
+    """The structural integrator's description; the loop is :func:`advance_galpha`."""
+
+    name: str
+    order: int
+    doc: str
+    kind: str = "implicit"
+    rho_inf: float = DEFAULT_RHO_INF
+    unconditionally_stable = True
+    starts_from_x_and_v = False
+
+    @property
+    def family(self) -> type:
+        return GeneralizedAlphaFamily
+
+    @property
+    def evaluations(self) -> int:
+        """Nominal force evaluations per step: about two Newton iterations (counted exactly in the accuracy
+        report)."""
+        return 2
+
+    @property
+    def reuses_last_force(self) -> bool:
+        return False
+
+    @property
+    def stability_limit(self) -> float:
+        return math.inf
+
+    def amplification(self, h: float, omega: float, gamma_force: float = 0.0, gamma_drag: float = 0.0,
+                      rho_inf: float | None = None):
+        """One step's 3x3 map of (x, v, a) for x'' = -omega^2 x - (gamma_force + gamma_drag) x' (the scheme
+        carries the acceleration: its spectral radius is rho_inf as h omega -> infinity)."""
+        am, af, gam, beta = coefficients(self.rho_inf if rho_inf is None else rho_inf)
+        k, c = omega * omega, gamma_force + gamma_drag
+        # unknowns (x1, v1, a1) from (x0, v0, a0): three linear equations
+        lhs = np.array([[1.0, 0.0, -beta * h * h], [0.0, 1.0, -gam * h],
+                        [(1 - af) * k, (1 - af) * c, 1 - am]])
+        rhs = np.array([[1.0, h, (0.5 - beta) * h * h], [0.0, 1.0, (1 - gam) * h],
+                        [-af * k, -af * c, -am]])
+        return np.linalg.solve(lhs, rhs)
+
+
+GALPHA = GeneralizedAlpha(
+    "galpha", 2,
+    "The structural integrator: generalized-alpha (Chung & Hulbert 1993), implicit, second order, stable at "
+    "any step, high modes damped by integrator.rho_inf; modified Newton on the banded matrix (O(N)).")
+
+Work = namedtuple("Work", ["Xk", "Xa", "Vk", "X", "V", "acc", "acc_box", "tmp"])
+"""The step's known parts (Xk, Xa, Vk), its unknowns at the force point (X, V), accelerations there and scratch,
+all (D, N)."""
+
+Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol", "step", "groups"])
+"""As SDIRK2's (:class:`ropesim.integrate.sdirk.Newton`), without the bodies."""
+
+Nodes = namedtuple("Nodes", ["free", "mass", "drag"])
+"""Per node: free (not held), mass [kg], linear drag b [kg/s] (0 at held nodes)."""
+
+
+class GeneralizedAlphaFamily(Integrator):
+    """Generalized-alpha with a modified-Newton solve on the banded matrix. Its complete state adds to x and v the
+    acceleration a_n, the statistics, the control flags and the factored matrix (reused across steps)."""
+
+    def __init__(self, model, grid, method: GeneralizedAlpha):
+        if model.body_pose0.shape[1]:
+            raise ValueError("galpha does not move free rigid bodies yet; a system with a free body runs with "
+                             "sdirk2, rk4 or a splitting scheme")
+        super().__init__(model, grid, method)
+        scene = model.scene
+        rho = getattr(scene.integrator, "rho_inf", None)
+        self.rho_inf = method.rho_inf if rho is None else float(rho)
+        self.coefficients = np.array(coefficients(self.rho_inf))
+        dim, n = model.dim, model.nodes
+        w, cyclic = band_width(any(line.closed for line in model.lines), n, coupling_reach(scene))
+        nt, m = dim * n, w * dim
+        jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
+        tol = NEWTON_TOL * min(line.segment_length for line in model.lines)
+        groups = model_groups(model, w, bodies=False) if WITH_JUNCTIONS.name in model.switches else None
+        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, tol, np.zeros(nt), groups)
+        self.work = Work(*(np.zeros((dim, n)) for _ in Work._fields))
+        self.nodes = Nodes(np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag))
+        self.acc_n = np.zeros((dim, n))
+        self.stats = np.zeros(3, dtype=np.int64)
+        self.control = np.zeros(3)
+        self.powers = np.zeros(6)
+        # the factored matrix is state: a resumed run reuses it exactly as the uninterrupted one did
+        self.matrix = {"band": jac.band, "corner": jac.corner,
+                       **{f"wood_{f}": a for f, a in zip(self.newton.wood._fields, self.newton.wood)}}
+        if groups is not None:
+            self.matrix.update(schur_w=groups.w, schur_s=groups.s, schur_piv=groups.piv, schur_own=groups.own)
+        for name, array in self.matrix.items():
+            setattr(self, name, array)
+        self.STATE = ("acc_n", "stats", "control", "powers", *self.matrix)
+        self.adapt = None
+        tol = scene.integrator.tolerance
+        if tol is not None:   # the scheme's own steps; x, v on the grid by dense output
+            rtol = scene.integrator.relative_tolerance or 0.0
+            self.adapt = new_adapt(self.x, self.v, self.ledger, grid.dt, tol, rtol)
+            self.newton = self.newton._replace(tol=max(self.newton.tol, NEWTON_FRACTION * tol))
+            for name in self.adapt._fields:
+                setattr(self, f"adapt_{name}", getattr(self.adapt, name))
+            self.STATE += tuple(f"adapt_{name}" for name in self.adapt._fields)
+
+    @classmethod
+    def switches_for(cls, model, method) -> frozenset:
+        """The model's switches, and the adaptive steps' with a tolerance."""
+        adaptive = getattr(model.scene.integrator, "tolerance", None) is not None
+        return model.switches | ({WITH_ADAPTIVE.name} if adaptive else set())
+
+    def step_report(self) -> dict | None:
+        """What the adaptive steps did, for summary.json (None with fixed steps)."""
+        if self.adapt is None:
+            return None
+        clock, counts = self.adapt.clock, self.adapt.counts
+        return {"tolerance_m": float(clock[TOL]), "relative_tolerance": float(clock[RTOL]),
+                "steps_taken": int(counts[ACCEPTED]), "steps_rejected": int(counts[REJECTED]),
+                "estimated_error_m": float(clock[EST_SUM]), "largest_local_error_m": float(clock[EST_MAX]),
+                "smallest_step_s": float(clock[H_MIN]) if counts[ACCEPTED] else None,
+                "largest_step_s": float(clock[H_MAX]) if counts[ACCEPTED] else None,
+                "newton_iterations": int(self.stats[ITERATIONS]), "factorisations": int(self.stats[FACTORISATIONS])}
+
+    @staticmethod
+    def template():
+        return advance_galpha
+
+    @property
+    def force_evaluations(self) -> int:
+        """Newton iterations so far (one force evaluation each), plus the start's."""
+        return int(self.stats[ITERATIONS])
+
+    @property
+    def factorisations(self) -> int:
+        return int(self.stats[FACTORISATIONS])
+
+    def _run(self, n, frames):
+        return self.loop((self.x, self.v, self.acc_n, self.ledger, self.stats, self.control, self.powers), self.work,
+                         self.newton, self.coefficients, self.held, self.nodes, self.model.params, self.limits,
+                         self.schedule(n), frames, self.bodies, self.adapt)
+
+
+@jit.kernel
+def start_acceleration(x, v, an, tmp, t, held, nodes, params):
+    """a_n = the accelerations at (x, v) at time t (drag, added mass and points included; zero at held nodes)."""
+    free, mass, drag = nodes
+    dim, n = x.shape
+    accelerations(x, v, an, params, t)
+    for d in range(dim):
+        for i in range(n):
+            an[d, i] -= drag[i] * v[d, i] / mass[i]
+    if WITH_ADDED_MASS or WITH_JUNCTIONS:
+        solve_accelerations(x, v, an, params)
+    for i in range(n):
+        if not free[i]:
+            for d in range(dim):
+                an[d, i] = 0.0
+
+
+@jit.kernel
+def step_start(x, v, an, work, co, h):
+    """The step's known parts: Xk = x + (1 - af) (h v + h^2 (1/2 - beta) a), Xa = Xk - c2 am a,
+    Vk = v + (1 - af) h (1 - gam) a, and the predictor X = x + (1 - af) (h v + h^2 a / 2) (a_(n+1) = a_n)."""
+    am, af, gam, beta = co[0], co[1], co[2], co[3]
+    c2 = (1.0 - af) * beta * h * h / (1.0 - am)
+    dim, n = x.shape
+    for d in range(dim):
+        for i in range(n):
+            a = an[d, i]
+            xk = x[d, i] + (1.0 - af) * (h * v[d, i] + h * h * (0.5 - beta) * a)
+            work.Xk[d, i] = xk
+            work.Xa[d, i] = xk - c2 * am * a
+            work.Vk[d, i] = v[d, i] + (1.0 - af) * h * (1.0 - gam) * a
+            work.X[d, i] = x[d, i] + (1.0 - af) * (h * v[d, i] + 0.5 * h * h * a)
+
+
+@jit.kernel
+def residual(work, rhs, c2, beta_v, t_f, held, nodes, params):
+    """At the force point X, with V = Vk + (X - Xk) / beta_v (held nodes: their own velocity), minus the
+    residual M (X - Xa) - c2 (F(X, V) - b V) into ``rhs`` (a point's: the sum of its nodes'). Returns (its
+    squared norm, fluid, internal-damping and seabed power [W])."""
+    Xk, Xa, Vk, X, V, acc = work.Xk, work.Xa, work.Vk, work.X, work.V, work.acc
+    free, mass, drag = nodes
+    dim, n = X.shape
+    for d in range(dim):
+        for i in range(n):
+            V[d, i] = Vk[d, i] + (X[d, i] - Xk[d, i]) / beta_v
+    for j in range(held.idx.shape[0]):
+        for d in range(dim):
+            V[d, held.idx[j]] = held.v[d, j]
+    fluid, internal, seabed = accelerations(X, V, acc, params, t_f)
+    for i in range(n):
+        for d in range(dim):
+            u = i * dim + d
+            if free[i]:
+                m = mass[i]
+                rhs[u] = -(m * (X[d, i] - Xa[d, i]) + c2 * (drag[i] * V[d, i] - m * acc[d, i]))
+            else:
+                rhs[u] = 0.0
+        if WITH_ADDED_MASS and free[i]:   # + A_i (X - Xa)
+            w0 = X[0, i] - Xa[0, i]
+            w1 = X[1, i] - Xa[1, i]
+            w2 = X[2, i] - Xa[2, i] if dim == 3 else 0.0
+            extra = added_mass_times(X, i, w0, w1, w2, params.added_mass, params.neighbours)
+            for d in range(dim):
+                rhs[i * dim + d] -= extra[d]
+    if WITH_JUNCTIONS:
+        if WITH_ADDED_MASS:
+            junction_added_mass_residual(X, Xa, Xa, 0.0, rhs, params.junctions, params.neighbours)
+        fold_junctions(rhs, params.junctions, dim)
+    norm = 0.0
+    for u in range(rhs.shape[0]):
+        norm += rhs[u] * rhs[u]
+    return norm, fluid, internal, seabed
+
+
+@jit.kernel
+def friction_slope(x, v, band, weight, free, seabed):
+    """Make the seabed friction's block its exact slope along the sliding velocity s (the shared assembly,
+    :func:`~ropesim.model.forces.seabed.add_seabed_jacobian`, puts mu N / S on the whole plane, S = sqrt(|s|^2 +
+    v_reg^2)): take away weight mu N s s^T / S^3, leaving mu N (I - s s^T / S^2) / S, which is the derivative of
+    mu N s / S (with mu the larger of the two friction coefficients, as there). Without it a node sliding well
+    above v_reg carries a damping S^2 / v_reg^2 times too large, and Newton converges linearly at large steps
+    (measured on mooring_chain at h = 0.1 s: a rate of 0.7 per iteration, and no convergence in 60)."""
+    bed, area = seabed
+    dim, n = x.shape
+    nx, ny = -bed[3], bed[2]
+    mu = max(bed[6], bed[7])
+    if mu <= 0.0:
+        return
+    for i in range(n):
+        if not free[i]:
+            continue
+        sunk = depth(x[0, i], x[1, i], bed)
+        if sunk <= 0.0:
+            continue
+        vn = v[0, i] * nx + v[1, i] * ny
+        s0, s1, s2 = v[0, i] - vn * nx, v[1, i] - vn * ny, v[2, i] if dim == 3 else 0.0
+        slide2 = s0 * s0 + s1 * s1 + s2 * s2
+        big = math.sqrt(slide2 + bed[8] * bed[8])
+        c = weight * mu * bed[4] * sunk * area[i] / (big * big * big)
+        s = (s0, s1, s2)
+        for a in range(dim):
+            for b in range(a + 1):
+                band[a - b, i * dim + b] -= c * s[a] * s[b]
+
+
+@jit.kernel
+def factor_matrix(work, newton, c2, beta_v, t_f, nodes, params):
+    """Assemble and factor M + c2 K + (c2 / beta_v) (C + b) at the force point (see the module doc). False when
+    it is singular."""
+    X, V = work.X, work.V
+    free, mass, drag = nodes
+    band = newton.jac.band
+    dim, n = X.shape
+    s = math.sqrt(c2)
+    newton_matrix(X, V, newton.jac, s, (free, mass, drag), params, t_f)   # a plain tuple, as the static solve's:
+    # the same compiled copy serves both (a namedtuple is another type, and compiled it again: 2.5 s)
+    for i in range(n):   # the linear drag's exact weight c2 / beta_v, not s
+        if free[i]:
+            for d in range(dim):
+                band[0, i * dim + d] += (c2 / beta_v - s) * drag[i]
+    if WITH_SEABED:
+        friction_slope(X, V, band, c2 / beta_v, free, params.seabed)
+    if WITH_JUNCTIONS:
+        if WITH_ADDED_MASS:
+            add_junction_added_mass_jacobian(X, band, params.junctions, params.neighbours)
+        return schur_factor(band, newton.jac.w, params.lines, newton.groups)
+    return factor(band, newton.jac.corner, newton.cyclic, band.shape[0] - 1, newton.wood)
+
+
+@jit.kernel(inline="always")
+def solve_step(work, newton, co, t, h, held, nodes, params, control, stats):
+    """Newton's solve of one step for the force point X (modified Newton: the matrix reused while it converges
+    fast). Returns (iterations, node, fluid, internal-damping and seabed power [W]); iterations < 0 when it
+    failed, naming the node that moved most in the last update."""
+    am, af, gam, beta = co[0], co[1], co[2], co[3]
+    c2 = (1.0 - af) * beta * h * h / (1.0 - am)
+    beta_v = beta * h / gam
+    t_f = t + (1.0 - af) * h
+    X, V = work.X, work.V
+    band, rhs = newton.jac.band, newton.rhs
+    p = band.shape[0] - 1
+    place(X, V, held, t_f, t + 0.5 * h)
+    refactor = control[FACTORED_H] == 0.0 or abs(h - control[FACTORED_H]) > REUSE_WITHIN * control[FACTORED_H]
+    worst_node = -1
+    last = np.inf
+    stride = 0.0
+    previous = 0.0
+    halvings = 0
+    for it in range(NEWTON_MAX_ITER):
+        norm, fluid, internal, seabed = residual(work, rhs, c2, beta_v, t_f, held, nodes, params)
+        if norm > last and stride > BACKTRACK_ABOVE * newton.tol and halvings < MAX_HALVINGS:
+            halvings += 1   # the update made things worse: go back half of it (and factor afresh there)
+            stride *= 0.5
+            take_back_half(X, newton.step)
+            refactor = True
+            continue
+        last = norm
+        halvings = 0
+        fresh = refactor
+        if refactor:
+            if not factor_matrix(work, newton, c2, beta_v, t_f, nodes, params):
+                control[FACTORED_H] = 0.0
+                return -1, 0, 0.0, 0.0, 0.0
+            control[FACTORED_H] = h
+            stats[FACTORISATIONS] += 1
+            refactor = False
+        if WITH_JUNCTIONS:
+            schur_solve(band, newton.jac.w, params.lines, newton.groups, rhs)
+        else:
+            solve(band, newton.jac.corner, newton.cyclic, p, rhs, newton.wood)
+        previous = stride
+        stride, worst_node = take_update(X, rhs, newton.step)
+        stats[ITERATIONS] += 1
+        rate = stride / previous if previous > 0.0 else 1.0
+        if stride <= newton.tol or (rate < 1.0 and stride * rate / (1.0 - rate) <= newton.tol):
+            for d in range(X.shape[0]):
+                for i in range(X.shape[1]):
+                    V[d, i] = work.Vk[d, i] + (X[d, i] - work.Xk[d, i]) / beta_v
+            for j in range(held.idx.shape[0]):
+                for d in range(X.shape[0]):
+                    V[d, held.idx[j]] = held.v[d, j]
+            return it + 1, -1, fluid, internal, seabed
+        if it > 0 and not fresh and rate > RATE_REFACTOR:
+            refactor = True   # the old matrix converges slowly here: factor it at this iterate
+    control[FACTORED_H] = 0.0
+    return -1, worst_node, 0.0, 0.0, 0.0
+
+
+@jit.kernel
+def step_end(x, v, an, work, co, h, free):
+    """From the solved force point: a_(n+1) = (X - Xk) / ((1 - af) beta h^2), x_(n+1) = x_n + (X - x_n) / (1 - af),
+    v_(n+1) = v_n + h ((1 - gam) a_n + gam a_(n+1)); held nodes are left to :func:`place` (a_n = 0 there)."""
+    am, af, gam, beta = co[0], co[1], co[2], co[3]
+    dim, n = x.shape
+    scale = 1.0 / ((1.0 - af) * beta * h * h)
+    for d in range(dim):
+        for i in range(n):
+            if not free[i]:
+                an[d, i] = 0.0
+                continue
+            a1 = (work.X[d, i] - work.Xk[d, i]) * scale
+            x[d, i] += (work.X[d, i] - x[d, i]) / (1.0 - af)
+            v[d, i] += h * ((1.0 - gam) * an[d, i] + gam * a1)
+            an[d, i] = a1
+
+
+@jit.kernel
+def book(ledger, powers, control, co, h, work, fluid, internal, seabed, held, nodes, params):
+    """The step's flows into the ledger. Each flow's power P is known at the force points, this step's
+    tau_1 = t_n + (1 - af) h and the last one's tau_0 = t_n - af h_last; the step books h P(t_n + h / 2) of the
+    line through both (second order; the first step, without a last force point, books h P(tau_1)). ``powers``
+    keeps this step's for the next (drag loss, held, fluid, internal, seabed, box [W])."""
+    X, V, acc, acc_box, tmp = work.X, work.V, work.acc, work.acc_box, work.tmp
+    free, mass, drag = nodes
+    dim, n = X.shape
+    af = co[1]
+    lost = 0.0
+    for d in range(dim):
+        for i in range(n):
+            lost += drag[i] * V[d, i] * V[d, i]
+    if WITH_ADDED_MASS:   # the fluid's inertial force, m a - F
+        for d in range(dim):
+            for i in range(n):
+                tmp[d, i] = acc[d, i] - drag[i] * V[d, i] / mass[i]
+        fluid += solve_accelerations(X, V, tmp, params)
+    box = 0.0
+    if WITH_APPLIED:
+        applied_accelerations(X, V, acc_box, params)
+        box = power(acc_box, V, mass)
+    now = (lost, held_power(acc, mass, held), fluid, internal, seabed, box)
+    w0 = 0.0
+    if control[LAST_H] > 0.0:   # P(mid) = P1 + (P1 - P0) (mid - tau_1) / (tau_1 - tau_0)
+        w0 = h * ((1.0 - af) * h - 0.5 * h) / (h * (1.0 - af) + af * control[LAST_H])
+    for k, column in enumerate((DRAG, HELD, FLUID, INTERNAL, SEABED, BOX)):
+        ledger[column] += h * now[k] + w0 * (powers[k] - now[k])
+        powers[k] = now[k]
+    control[LAST_H] = h
+
+
+@jit.kernel
+def advance_galpha(state, work, newton, co, held, nodes, params, limits, schedule, frames, bodies, adapt):
+    """Advance ``schedule.n_steps`` generalized-alpha steps in place; the contract of :mod:`ropesim.integrate.base`.
+
+    ``state`` = (x, v, a_n, ledger, stats, control, last powers); ``adapt`` the adaptive steps' state
+    (:mod:`ropesim.integrate.galpha_adaptive`; None with fixed steps). Returns (steps done, frames written,
+    status, node)."""
+    x, v, an, ledger, stats, control, powers = state
+    h = schedule.h
+    frame = np.int64(0)   # not the literal 0: Numba would compile the frame saving twice (for 0, then int64)
+    if control[STARTED] == 0.0:
+        start_acceleration(x, v, an, work.tmp, schedule.step0 * h, held, nodes, params)
+        stats[ITERATIONS] += 1
+        control[STARTED] = 1.0
+    if WITH_ADAPTIVE:
+        return advance_adaptive(state, work, newton, co, held, nodes, params, limits, schedule, frames, bodies,
+                                adapt)
+    for s in range(schedule.n_steps):
+        step = schedule.step0 + s
+        t = step * h
+        step_start(x, v, an, work, co, h)
+        its, node, fluid, internal, seabed = solve_step(work, newton, co, t, h, held, nodes, params, control, stats)
+        if its < 0:
+            return s, frame, NEWTON_FAILED, node
+        book(ledger, powers, control, co, h, work, fluid, internal, seabed, held, nodes, params)
+        step_end(x, v, an, work, co, h, nodes.free)
+        stats[STEPS] += 1
+        place(x, v, held, (step + 1) * h, (step + 1) * h)
+        done = step + 1
+        if not due(done, schedule):
+            continue
+        status, node, frame = end_step(done, schedule, x, v, nodes.mass, params, ledger, limits, frames, frame,
+                                       bodies)
+        if status != OK:
+            return s + 1, frame, status, node
+    return schedule.n_steps, frame, OK, -1
+
+
+@jit.kernel(inline="always")
+def filtered_error_ratio(work, an, co, h, x, newton, nodes, params, clock, share):
+    """The step's error estimate filtered by the factored Newton matrix, J^-1 M e (see
+    :mod:`ropesim.integrate.galpha_adaptive`), over its allowance; returns (ratio, the largest error [m], its
+    node)."""
+    band, rhs = newton.jac.band, newton.rhs
+    raw_error(work, an, co, h, nodes, rhs)
+    if WITH_JUNCTIONS:
+        fold_junctions(rhs, params.junctions, x.shape[0])
+        schur_solve(band, newton.jac.w, params.lines, newton.groups, rhs)
+    else:
+        solve(band, newton.jac.corner, newton.cyclic, band.shape[0] - 1, rhs, newton.wood)
+    return error_ratio(rhs, x, work.X, co[1], clock[TOL], clock[RTOL], nodes.free, share)
+
+
+@jit.kernel
+def advance_adaptive(state, work, newton, co, held, nodes, params, limits, schedule, frames, bodies, adapt):
+    """The grid steps ``schedule.step0`` + 1 ... + n_steps, each read off the scheme's own steps by dense output
+    (:mod:`ropesim.integrate.galpha_adaptive`); the internal steps chosen by the error estimate."""
+    x, v, an, ledger, stats, control, powers = state
+    x1, v1, clock, counts = adapt.x1, adapt.v1, adapt.clock, adapt.counts
+    free = nodes.free
+    t_end = schedule.total_steps * schedule.h
+    frame = np.int64(0)
+    for s in range(schedule.n_steps):
+        done = schedule.step0 + s + 1
+        target = done * schedule.h if done < schedule.total_steps else t_end
+        while clock[T1] < target * (1.0 - 1e-13):
+            t = clock[T1]
+            h = min(clock[H_NEXT], t_end - t)
+            while True:
+                if h < SMALLEST * t_end:
+                    return s, frame, NEWTON_FAILED, -1
+                step_start(x1, v1, an, work, co, h)
+                its, node, fluid, internal, seabed = solve_step(work, newton, co, t, h, held, nodes, params,
+                                                                control, stats)
+                if its < 0:
+                    counts[REJECTED] += 1
+                    h *= NEWTON_SHRINK
+                    continue
+                ratio, error, limiting = filtered_error_ratio(work, an, co, h, x1, newton, nodes, params, clock, h / t_end)
+                if ratio > 1.0:
+                    counts[REJECTED] += 1
+                    h = next_step(h, ratio)
+                    continue
+                break
+            for d in range(x1.shape[0]):
+                for i in range(x1.shape[1]):
+                    adapt.x0[d, i] = x1[d, i]
+                    adapt.v0[d, i] = v1[d, i]
+            for k in range(ledger.shape[0]):
+                adapt.ledger0[k] = adapt.ledger1[k]
+            book(adapt.ledger1, powers, control, co, h, work, fluid, internal, seabed, held, nodes, params)
+            step_end(x1, v1, an, work, co, h, free)
+            place(x1, v1, held, t + h, t + h)
+            stats[STEPS] += 1
+            counts[ACCEPTED] += 1
+            clock[T0] = t
+            clock[T1] = t + h
+            clock[EST_MAX] = max(clock[EST_MAX], error)
+            clock[EST_SUM] += error
+            clock[H_MIN] = min(clock[H_MIN], h)
+            clock[H_MAX] = max(clock[H_MAX], h)
+            clock[LIMITING] = limiting
+            if t + h < t_end:   # the last step, cut to reach t_end, says nothing of the next
+                clock[H_NEXT] = next_step(h, ratio)
+        dense_output(adapt, target, x, v, ledger)
+        place(x, v, held, target, target)
+        if not due(done, schedule):
+            continue
+        status, node, frame = end_step(done, schedule, x, v, nodes.mass, params, ledger, limits, frames, frame,
+                                       bodies)
+        if status != OK:
+            return s + 1, frame, status, node
+    return schedule.n_steps, frame, OK, -1

@@ -1,0 +1,107 @@
+"""What one galpha step costs on WD0050 (bench_moorings' case, MoorDyn's seabed law), part by part, against
+MoorDyn's RK2 step.
+
+    python scripts/bench_galpha_step.py [--tolerance 0.1] [--dt 0.0125] [--window 30] [--calls 2000] [--rho-inf R]
+        [--own-seabed]
+
+Times each compiled part of a step on the case's state at rest (the force evaluation with its residual, the
+matrix's assembly and factorisation, a solve with the factored matrix), then runs the case with adaptive steps
+at ``--tolerance`` and with fixed steps of ``--dt``, and breaks the run's time into those parts from its counts
+(steps, rejections, Newton iterations, factorisations). MoorDyn's RK2 step is two force evaluations of its own
+(its ns per node and evaluation from bench_moorings' term costs).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path[:0] = [str(ROOT), str(ROOT / "scripts"), str(ROOT / "tests")]
+
+
+def main() -> int:
+    import tomli_w
+
+    import ropesim
+    from bench_moorings import DT_OUT, SEABED, SURGE, problem
+    from references.moordyn_own_cases import chain_scene_dict
+    from ropesim.integrate import galpha as G
+    from ropesim.integrate.grid import TimeGrid
+    from ropesim.integrate.methods import make_integrator
+    from ropesim.model.banded import solve
+    from ropesim.model.build import build
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--tolerance", type=float, default=0.1)
+    parser.add_argument("--dt", type=float, default=0.0125)
+    parser.add_argument("--window", type=float, default=30.0)
+    parser.add_argument("--calls", type=int, default=2000)
+    parser.add_argument("--rho-inf", type=float, default=None)
+    parser.add_argument("--own-seabed", action="store_true",
+                        help="ropesim's own seabed damping (into the plane only, ramped in) instead of MoorDyn's")
+    args = parser.parse_args()
+    SEABED["both_ways"] = not args.own_seabed
+    case, start = problem()
+
+    def integrator(dt, tol=None):
+        scene = chain_scene_dict(case, start, method="galpha", dt=dt, t_end=args.window, interval=DT_OUT,
+                                 dimension=3, both_ways=SEABED["both_ways"], surge=SURGE)
+        if tol is not None:
+            scene["integrator"]["tolerance"] = tol
+        if args.rho_inf is not None:
+            scene["integrator"]["rho_inf"] = args.rho_inf
+        s = ropesim.scene_from_toml(tomli_w.dumps(scene))
+        model, grid = build(s), TimeGrid.of(s)
+        return make_integrator(model, grid), grid
+
+    it, grid = integrator(args.dt)
+    it.warm_up()
+    k, w, co, h = it.kernel, it.work, it.coefficients, args.dt
+    am, af, gam, beta = co
+    c2, bv = (1 - af) * beta * h * h / (1 - am), beta * h / gam
+    k(G.step_start)(it.x, it.v, it.acc_n, w, co, h)
+    nw, p = it.newton, it.model.params
+    parts = {}
+    for name, call in (
+            ("force evaluation + residual", lambda: k(G.residual)(w, nw.rhs, c2, bv, 0.5 * h, it.held, it.nodes, p)),
+            ("assembly + factorisation", lambda: k(G.factor_matrix)(w, nw, c2, bv, 0.5 * h, it.nodes, p)),
+            ("solve (factored)", lambda: k(solve)(nw.jac.band, nw.jac.corner, nw.cyclic, nw.jac.band.shape[0] - 1,
+                                                  nw.rhs, nw.wood))):
+        call()
+        tick = time.perf_counter()
+        for _ in range(args.calls):
+            call()
+        parts[name] = (time.perf_counter() - tick) / args.calls
+    nodes = it.model.nodes
+    print(f"WD0050, {nodes} nodes, 3-D; per call (Python call overhead included, about 1 us):")
+    for name, sec in parts.items():
+        print(f"  {name:30s} {sec * 1e6:8.1f} us  ({sec * 1e9 / nodes:6.0f} ns per node)")
+    for label, (dt, tol) in (("adaptive", (DT_OUT, args.tolerance)), ("fixed", (args.dt, None))):
+        it, grid = integrator(dt, tol)
+        it.warm_up()
+        tick = time.perf_counter()
+        result = it.advance(grid.steps)
+        wall = time.perf_counter() - tick
+        report = it.step_report() or {"steps_taken": int(it.stats[G.STEPS]), "steps_rejected": 0}
+        its, fac = int(it.stats[G.ITERATIONS]), int(it.stats[G.FACTORISATIONS])
+        steps = report["steps_taken"] + report["steps_rejected"]
+        model_cost = (its * (parts["force evaluation + residual"] + parts["solve (factored)"])
+                      + fac * parts["assembly + factorisation"])
+        print(f"\n{label} ({'tolerance %g m' % tol if tol else 'dt %g s' % dt}), {args.window:g} s: status "
+              f"{result.status}, {wall:.3f} s ({wall / args.window * 1e3:.2f} ms per simulated s); steps taken "
+              f"{report['steps_taken']}, rejected {report['steps_rejected']}; Newton iterations {its} "
+              f"({its / max(steps, 1):.2f} per attempted step), factorisations {fac} ({fac / max(steps, 1):.2f} per "
+              f"step); the parts above account for {model_cost:.3f} s: iterations {its * parts['force evaluation + residual']:.3f} s, "
+              f"solves {its * parts['solve (factored)']:.3f} s, factorisations {fac * parts['assembly + factorisation']:.3f} s")
+        if report["steps_taken"]:
+            print(f"  mean step {args.window / report['steps_taken'] * 1e3:.2f} ms")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
