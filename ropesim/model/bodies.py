@@ -28,6 +28,14 @@ left out, as MoorDyn leaves them out. The 6 x 6 matrix is symmetric positive def
 may be zero when its attachments carry it); in 2-D the body moves in x, y and turns about z, and the solve keeps
 those three degrees of freedom.
 
+The explicit methods solve these equations in the body's axes (:func:`move_bodies`), where the matrix is constant
+(its own mass, inertia and added mass, and each attachment's isotropic m_i + a_n at its fixed arm s_i) but for the
+attachments' added mass along their lines, (a_t - a_n) q q^T at s_i: a rank-one term u u^T, u = (q, s_i x q), q the
+line's tangent in body axes. The constant part is factored (L D L^T) once when the model is built; a body whose
+lines have a_t != a_n adds its rank-one terms and factors its 6 x 6 per evaluation (a few hundred flops). Only the
+right-hand side is rotated in and the accelerations out. The stiff integrator's Newton solve and the static solver
+assemble the same equations in world axes (:func:`body_own_system`, :func:`body_attachments_system`).
+
 The power of the fluid's forces on the body (drag, and the added mass's inertial force -A a) is booked as fluid
 work, as for a node. Gravity and buoyancy are conservative: the body's mechanical energy is
 1/2 m |v + w x c|^2 + 1/2 w . I w + m g (r + c)_y - rho V g (r + R c_B)_y (:func:`body_energy`).
@@ -37,8 +45,11 @@ Parameters, :class:`Bodies` (B free bodies, K attachments): per body mass (B,) [
 body axes [kg m^2], ``lift`` (B,) rho V g [N], ``drag`` (3, B) 1/2 rho CdA [kg/m], ``drag_rot`` (3, B) 1/2 rho Cd_r
 [kg m^2], ``added`` (3, B) [kg] and ``added_rot`` (3, B) [kg m^2] on the body axes; body b's attachments are
 ``nodes[start[b]:start[b + 1]]`` at arms ``arm`` (3, K) [m], with their line added-mass coefficients
-``node_added`` (2, K) [kg] (a_n, a_t: the per-node added-mass pass leaves them to this one); ``work`` (6, 7) is
-the solve's scratch.
+``node_added`` (2, K) [kg] (a_n, a_t: the per-node added-mass pass leaves them to this one); ``mass0`` (B, 6, 6)
+the constant part of each body's mass matrix in body axes and ``factor`` (B, 6, 6) its L D L^T, on the kept rows
+``rows`` (6 in 3-D, x, y and the turn about z in 2-D: the leading n x n of each), ``varies`` (B,) whether a body
+has attachments with a_t != a_n; ``attached_mass`` (K,) [kg] the attachments' masses; scratch: ``tangent`` (3, K)
+their lines' tangents in body axes, ``work`` (6, 7) the solve's.
 """
 
 from __future__ import annotations
@@ -56,7 +67,8 @@ from .rotation import cross, matrix_of, quaternion_from_angles, rotate, rotate_b
 WITH_BODIES = jit.Switch("bodies", "free rigid bodies")
 
 Bodies = namedtuple("Bodies", ["mass", "cog", "inertia", "lift", "cob", "drag", "drag_rot", "added", "added_rot",
-                               "spring", "damper", "rest", "start", "nodes", "arm", "node_added", "work"])
+                               "spring", "damper", "rest", "start", "nodes", "arm", "node_added", "mass0", "factor",
+                               "varies", "rows", "attached_mass", "tangent", "work"])
 
 POSE, TWIST = 7, 6   # rows of the pose (r, q) and twist (v, w) arrays
 STATE_ROWS = POSE + TWIST   # a saved frame's rows per body
@@ -116,9 +128,10 @@ def initial_pose(body, dim: int) -> np.ndarray:
     return np.concatenate([vector3(body.position, dim), quaternion_from_angles(body.orientation, dim)])
 
 
-def bodies_bundle(scene, ends: dict[str, list[int]], added: np.ndarray) -> Bodies:
-    """The compiled description of the scene's free bodies (see the module doc); their attachments' added-mass
-    coefficients are taken out of ``added`` (2, N), which the per-node pass then skips."""
+def bodies_bundle(scene, ends: dict[str, list[int]], added: np.ndarray, node_mass: np.ndarray) -> Bodies:
+    """The compiled description of the scene's free bodies (see the module doc), their attachments' masses from
+    ``node_mass`` (N,) [kg]; their attachments' added-mass coefficients are taken out of ``added`` (2, N), which the
+    per-node pass then skips."""
     dim = scene.dimension
     bodies = free_bodies(scene)
     rho = scene.fluid.density if scene.fluid is not None else 0.0
@@ -152,9 +165,50 @@ def bodies_bundle(scene, ends: dict[str, list[int]], added: np.ndarray) -> Bodie
         node_added[:] = added[:, node_index]
         added[:, node_index] = 0.0
     arm = np.array(arms, dtype=float).T.copy() if arms else np.zeros((3, 0))
+    rows = np.arange(6) if dim == 3 else np.array([0, 1, 5])
+    mass0, factor, varies = np.zeros((count, 6, 6)), np.zeros((count, 6, 6)), np.zeros(count, dtype=np.int64)
+    for b in range(count):
+        own = constant_mass(mass[b], out["cog"][:, b], inertia[:, :, b], out["added"][:, b], out["added_rot"][:, b],
+                            node_mass[node_index[start[b]:start[b + 1]]] + node_added[0, start[b]:start[b + 1]],
+                            arm[:, start[b]:start[b + 1]])
+        n = len(rows)
+        mass0[b, :n, :n] = own[np.ix_(rows, rows)]
+        factor[b, :n, :n] = ldl_factor(mass0[b, :n, :n])
+        varies[b] = np.any(node_added[1, start[b]:start[b + 1]] != node_added[0, start[b]:start[b + 1]])
     return Bodies(mass, out["cog"], inertia, lift, out["cob"], out["drag"], out["drag_rot"], out["added"],
                   out["added_rot"], out["spring"], out["damper"], out["rest"], start, node_index, arm, node_added,
-                  np.zeros((6, 7)))
+                  mass0, factor, varies, rows.astype(np.int64), 1.0 / (1.0 / node_mass[node_index]),
+                  np.zeros((3, len(nodes))), np.zeros((6, 7)))
+
+
+def mass_at(mass: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The 6 x 6 mass matrix about the reference point of a 3 x 3 mass matrix at arm p [m]:
+    [[M, -M [p]x], [[p]x M, -[p]x M [p]x]]."""
+    px = np.array([[0.0, -p[2], p[1]], [p[2], 0.0, -p[0]], [-p[1], p[0], 0.0]])
+    return np.block([[mass, -mass @ px], [px @ mass, -px @ mass @ px]])
+
+
+def constant_mass(m, cog, inertia, added, added_rot, masses, arms) -> np.ndarray:
+    """A body's mass matrix (6, 6) about its reference point in its own axes, all of it that is constant there:
+    its mass m [kg] at its centre of gravity ``cog`` (3,) [m], its inertia (3, 3) [kg m^2], added mass and added
+    inertia (3,) on its axes, and its attachments' isotropic masses (K,) [kg] (each node's m_i + a_n) at ``arms``
+    (3, K) [m]. What is left is each attachment's (a_t - a_n) q q^T along its line's tangent q."""
+    out = mass_at(m * np.eye(3), cog)
+    out[3:, 3:] += inertia
+    out += np.diag(np.concatenate([added, added_rot]))
+    for mk, arm in zip(masses, arms.T):
+        out += mass_at(mk * np.eye(3), arm)
+    return out
+
+
+def ldl_factor(a: np.ndarray) -> np.ndarray:
+    """A = L D L^T of a symmetric positive definite a (n, n), as :func:`_ldl_factor` computes it compiled: L's
+    strict lower part, D on the diagonal (the upper part left as it was)."""
+    f = np.array(a, dtype=float)
+    for j in range(len(f)):
+        f[j, j] -= np.sum(f[j, :j] ** 2 * np.diag(f)[:j])
+        f[j + 1:, j] = (f[j + 1:, j] - f[j + 1:, :j] @ (f[j, :j] * np.diag(f)[:j])) / f[j, j]
+    return f
 
 
 def no_bodies() -> None:
@@ -256,50 +310,113 @@ def _add_rotated(work, row, col, r, d0, d1, d2):
                 d2 * r[3 * i + 2] * r[3 * j + 2]
 
 
-@jit.kernel
-def _solve(work, planar):
-    """Solve the symmetric positive definite system in ``work`` (6, 7) (the matrix, then the right-hand side) by
-    Gaussian elimination without pivoting, in place; the solution ends in column 6. ``planar``: x, y and the turn
-    about z alone (rows 0, 1, 5), the other unknowns set to 0."""
-    if planar:
-        keep = (0, 1, 5)
-        for a in range(3):
-            for b in range(3):
-                work[a, b] = work[keep[a], keep[b]]
-            work[a, 6] = work[keep[a], 6]
-        n = 3
-    else:
-        n = 6
-    for k in range(n):
-        pivot = work[k, k]
-        for i in range(k + 1, n):
-            f = work[i, k] / pivot
-            for j in range(k, n):
-                work[i, j] -= f * work[k, j]
-            work[i, 6] -= f * work[k, 6]
-    for k in range(n - 1, -1, -1):
-        s = work[k, 6]
-        for j in range(k + 1, n):
-            s -= work[k, j] * work[j, 6]
-        work[k, 6] = s / work[k, k]
-    if planar:
-        a2 = work[2, 6]
-        work[5, 6] = a2
-        work[2, 6] = work[3, 6] = work[4, 6] = 0.0
+@jit.kernel(inline="always")
+def _ldl_factor(a, n):
+    """A = L D L^T in place in a (n, n) symmetric positive definite matrix (its lower triangle read): L's strict
+    lower part and D on the diagonal (:func:`ldl_factor`)."""
+    for j in range(n):
+        d = a[j, j]
+        for k in range(j):
+            d -= a[j, k] * a[j, k] * a[k, k]
+        a[j, j] = d
+        inverse = 1.0 / d
+        for i in range(j + 1, n):
+            s = a[i, j]
+            for k in range(j):
+                s -= a[i, k] * a[j, k] * a[k, k]
+            a[i, j] = s * inverse
+
+
+@jit.kernel(inline="always")
+def _ldl_solve(f, n, work):
+    """Solve (L D L^T) y = work[:n, 6] in place, ``f`` holding L and D (:func:`_ldl_factor`)."""
+    for i in range(n):
+        s = work[i, 6]
+        for k in range(i):
+            s -= f[i, k] * work[k, 6]
+        work[i, 6] = s
+    for i in range(n):
+        work[i, 6] /= f[i, i]
+    for i in range(n - 1, -1, -1):
+        s = work[i, 6]
+        for k in range(i + 1, n):
+            s -= f[k, i] * work[k, 6]
+        work[i, 6] = s
+
+
+@jit.kernel(inline="always")
+def own_load(gravity, flow, bodies, pose, twist, b, t, r):
+    """Body b's own force [N] and moment [N m] about its reference point, in its axes (R^T of the world's): its
+    weight and centripetal force at its centre of gravity, the gyroscopic moment -w x (I w), its buoyancy at its
+    centre of buoyancy, its drag and rotational drag, its linear spring and damper (see the module doc); and the
+    power [W] of the drag and the damper, as (f0, f1, f2, m0, m1, m2, power). ``r``: R's nine entries."""
+    wb0, wb1, wb2 = rotate_back(r, twist[3, b], twist[4, b], twist[5, b])
+    vb0, vb1, vb2 = rotate_back(r, twist[0, b], twist[1, b], twist[2, b])
+    up0, up1, up2 = r[3], r[4], r[5]   # the world's up, R^T y, in body axes
+    m = bodies.mass[b]
+    c0, c1, c2 = bodies.cog[0, b], bodies.cog[1, b], bodies.cog[2, b]
+    e0, e1, e2 = cross(wb0, wb1, wb2, c0, c1, c2)
+    n0, n1, n2 = cross(wb0, wb1, wb2, e0, e1, e2)   # w x (w x c)
+    mg = m * gravity
+    f0, f1, f2 = -m * n0 - mg * up0, -m * n1 - mg * up1, -m * n2 - mg * up2
+    inertia = bodies.inertia
+    j0 = inertia[0, 0, b] * wb0 + inertia[0, 1, b] * wb1 + inertia[0, 2, b] * wb2   # I_b w
+    j1 = inertia[1, 0, b] * wb0 + inertia[1, 1, b] * wb1 + inertia[1, 2, b] * wb2
+    j2 = inertia[2, 0, b] * wb0 + inertia[2, 1, b] * wb1 + inertia[2, 2, b] * wb2
+    g0, g1, g2 = cross(wb0, wb1, wb2, j0, j1, j2)
+    m0, m1, m2 = cross(c0, c1, c2, f0, f1, f2)
+    m0, m1, m2 = m0 - g0, m1 - g1, m2 - g2
+    lift = bodies.lift[b]
+    if lift != 0.0:
+        l0, l1, l2 = lift * up0, lift * up1, lift * up2
+        k0, k1, k2 = cross(bodies.cob[0, b], bodies.cob[1, b], bodies.cob[2, b], l0, l1, l2)
+        f0, f1, f2 = f0 + l0, f1 + l1, f2 + l2
+        m0, m1, m2 = m0 + k0, m1 + k1, m2 + k2
+    # drag on the flow relative to the reference point, and the rotational drag
+    u0, u1, u2 = -twist[0, b], -twist[1, b], -twist[2, b]
+    if WITH_FLOW:
+        U0, U1, U2 = flow_at(pose[1, b], t, flow[0], flow[1])
+        u0 += U0
+        u1 += U1
+        u2 += U2
+    speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+    spin = math.sqrt(wb0 * wb0 + wb1 * wb1 + wb2 * wb2)
+    ub0, ub1, ub2 = rotate_back(r, u0, u1, u2)
+    d0, d1, d2 = bodies.drag[0, b] * speed * ub0, bodies.drag[1, b] * speed * ub1, bodies.drag[2, b] * speed * ub2
+    s0 = -bodies.drag_rot[0, b] * spin * wb0
+    s1 = -bodies.drag_rot[1, b] * spin * wb1
+    s2 = -bodies.drag_rot[2, b] * spin * wb2
+    power = d0 * vb0 + d1 * vb1 + d2 * vb2 + s0 * wb0 + s1 * wb1 + s2 * wb2
+    f0, f1, f2, m0, m1, m2 = f0 + d0, f1 + d1, f2 + d2, m0 + s0, m1 + s1, m2 + s2
+    # the linear spring and damper on the reference point (world axes; no moment about it); the damper's power is
+    # the fluid's
+    h0, h1, h2 = 0.0, 0.0, 0.0
+    for k in range(3):
+        if bodies.spring[k, b] != 0.0 or bodies.damper[k, b] != 0.0:
+            damping = bodies.damper[k, b] * twist[k, b]
+            pull = -(bodies.spring[k, b] * (pose[k, b] - bodies.rest[k, b]) + damping)
+            power -= damping * twist[k, b]
+            if k == 0:
+                h0 = pull
+            elif k == 1:
+                h1 = pull
+            else:
+                h2 = pull
+    if h0 != 0.0 or h1 != 0.0 or h2 != 0.0:
+        hb0, hb1, hb2 = rotate_back(r, h0, h1, h2)
+        f0, f1, f2 = f0 + hb0, f1 + hb1, f2 + hb2
+    return f0, f1, f2, m0, m1, m2, power
 
 
 @jit.kernel(inline="always")
 def body_own_system(work, gravity, flow, bodies, pose, twist, b, t, power):
-    """Body b's own part of its Newton-Euler equations (see the module doc) into ``work`` (6, 7), zeroed first:
-    its mass at its centre of gravity, inertia and added mass (the matrix), its weight, centripetal force,
-    gyroscopic moment, buoyancy and drag (the right-hand side); returns ``power`` [W] plus the drag's."""
+    """Body b's own part of its Newton-Euler equations (see the module doc) into ``work`` (6, 7), zeroed first, in
+    world axes: its mass at its centre of gravity, inertia and added mass (the matrix), its own force and moment
+    (:func:`own_load`, the right-hand side); returns ``power`` [W] plus the drag's and the damper's."""
     r = matrix_of(pose[3:7], b)
-    w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
-    v0, v1, v2 = twist[0, b], twist[1, b], twist[2, b]
     for i in range(6):
         for j in range(7):
             work[i, j] = 0.0
-    # the body's own mass at its centre of gravity, its inertia and added mass
     m = bodies.mass[b]
     c0, c1, c2 = rotate(r, bodies.cog[0, b], bodies.cog[1, b], bodies.cog[2, b])
     _add_mass_at(work, m, 0.0, 0.0, m, 0.0, m, c0, c1, c2)
@@ -312,60 +429,17 @@ def body_own_system(work, gravity, flow, bodies, pose, twist, b, t, power):
             work[3 + i, 3 + j] += s
     _add_rotated(work, 0, 0, r, bodies.added[0, b], bodies.added[1, b], bodies.added[2, b])
     _add_rotated(work, 3, 3, r, bodies.added_rot[0, b], bodies.added_rot[1, b], bodies.added_rot[2, b])
-    # its weight and centripetal force at c, the gyroscopic moment w x (I w), buoyancy at its centre of buoyancy
-    e0, e1, e2 = cross(w0, w1, w2, c0, c1, c2)
-    n0, n1, n2 = cross(w0, w1, w2, e0, e1, e2)   # w x (w x c)
-    f0, f1, f2 = -m * n0, -m * n1 - m * gravity, -m * n2
-    wb = rotate_back(r, w0, w1, w2)
-    j0 = j1 = j2 = 0.0   # I_b (R^T w)
-    for l in range(3):
-        j0 += bodies.inertia[0, l, b] * wb[l]
-        j1 += bodies.inertia[1, l, b] * wb[l]
-        j2 += bodies.inertia[2, l, b] * wb[l]
-    i0, i1, i2 = rotate(r, j0, j1, j2)   # (R I_b R^T) w
-    g0, g1, g2 = cross(w0, w1, w2, i0, i1, i2)
-    m0, m1, m2 = cross(c0, c1, c2, f0, f1, f2)
-    work[0, 6] += f0
-    work[1, 6] += f1
-    work[2, 6] += f2
-    work[3, 6] += m0 - g0
-    work[4, 6] += m1 - g1
-    work[5, 6] += m2 - g2
-    lift = bodies.lift[b]
-    if lift != 0.0:
-        k0, _, k2 = rotate(r, bodies.cob[0, b], bodies.cob[1, b], bodies.cob[2, b])
-        work[1, 6] += lift
-        work[3, 6] -= k2 * lift   # (k x lift y)_x = -k_z lift
-        work[5, 6] += k0 * lift
-    # drag on the flow relative to the reference point, in body axes
-    u0, u1, u2 = -v0, -v1, -v2
-    if WITH_FLOW:
-        U0, U1, U2 = flow_at(pose[1, b], t, flow[0], flow[1])
-        u0 += U0
-        u1 += U1
-        u2 += U2
-    speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
-    spin = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
-    ub = rotate_back(r, u0, u1, u2)
-    for k in range(3):
-        fb = bodies.drag[k, b] * speed * ub[k]
-        tb = -bodies.drag_rot[k, b] * spin * wb[k]
-        for i in range(3):
-            work[i, 6] += r[3 * i + k] * fb
-            work[3 + i, 6] += r[3 * i + k] * tb
-            power += r[3 * i + k] * (fb * twist[i, b] + tb * twist[3 + i, b])
-    # the linear spring and damper on the reference point (no moment about it); the damper's power is the fluid's
-    for k in range(3):
-        damping = bodies.damper[k, b] * twist[k, b]
-        work[k, 6] -= bodies.spring[k, b] * (pose[k, b] - bodies.rest[k, b]) + damping
-        power -= damping * twist[k, b]
-    return power
+    f0, f1, f2, m0, m1, m2, own = own_load(gravity, flow, bodies, pose, twist, b, t, r)
+    work[0, 6], work[1, 6], work[2, 6] = rotate(r, f0, f1, f2)
+    work[3, 6], work[4, 6], work[5, 6] = rotate(r, m0, m1, m2)
+    return power + own
 
 
 @jit.kernel(inline="always")
 def body_attachments_system(work, x, acc, inv_mass, around, bodies, pose, twist, b):
-    """Add body b's attachments to its Newton-Euler equations in ``work`` (6, 7): each node's mass and added
-    mass at its arm, and its force m_i acc_i less its centripetal part (``acc`` holding each node's F_i / m_i)."""
+    """Add body b's attachments to its Newton-Euler equations in ``work`` (6, 7), world axes: each node's mass and
+    added mass at its arm, and its force m_i acc_i less its centripetal part (``acc`` holding each node's
+    F_i / m_i)."""
     dim = x.shape[0]
     start, nodes, arm, node_added = bodies.start, bodies.nodes, bodies.arm, bodies.node_added
     r = matrix_of(pose[3:7], b)
@@ -402,49 +476,100 @@ def body_attachments_system(work, x, acc, inv_mass, around, bodies, pose, twist,
 def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist, out, t):
     """The free bodies' accelerations (see the module doc) into ``out`` (6, B) (a, then alpha), from ``acc``
     holding each attachment node's F_i / m_i, and every attachment's acceleration a + alpha x rho + w x (w x rho)
-    into ``acc``; returns the power [W] of the fluid's forces on the bodies (drag and added mass). The equations
-    are assembled by :func:`body_own_system` and :func:`body_attachments_system` (which the stiff integrator's
-    Newton solve takes as its residual, :mod:`ropesim.model.body_newton`)."""
+    into ``acc``; returns the power [W] of the fluid's forces on the bodies (drag and added mass).
+
+    Solved in the body's axes, where its mass matrix is constant but for its attachments' added mass along their
+    lines' tangents, (a_t - a_n) q q^T at each arm, a rank-one term u u^T with u = (q, s x q): the constant part
+    is factored once (``bodies.factor``, :func:`bodies_bundle`), and a body with such terms adds them to it and
+    factors its 6 x 6 (3 x 3 in 2-D) matrix per evaluation. The stiff integrator's Newton solve assembles the same
+    equations in world axes (:func:`body_own_system`, :func:`body_attachments_system`)."""
     dim = x.shape[0]
     work = bodies.work
     start, nodes, arm, node_added = bodies.start, bodies.nodes, bodies.arm, bodies.node_added
+    n = bodies.rows.shape[0]
     power = 0.0
     for b in range(start.shape[0] - 1):
         r = matrix_of(pose[3:7], b)
         w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
-        v0, v1, v2 = twist[0, b], twist[1, b], twist[2, b]
-        power = body_own_system(work, gravity, flow, bodies, pose, twist, b, t, power)
-        wb = rotate_back(r, w0, w1, w2)
-        body_attachments_system(work, x, acc, inv_mass, around, bodies, pose, twist, b)
-        _solve(work, dim == 2)
-        a0, a1, a2, al0, al1, al2 = work[0, 6], work[1, 6], work[2, 6], work[3, 6], work[4, 6], work[5, 6]
-        for d in range(6):
-            out[d, b] = work[d, 6]
-        # the fluid's inertial force on the body's own added mass: -A_t a . v - A_r alpha . w
-        ab = rotate_back(r, a0, a1, a2)
-        vb = rotate_back(r, v0, v1, v2)
-        alb = rotate_back(r, al0, al1, al2)
-        for k in range(3):
-            power -= bodies.added[k, b] * ab[k] * vb[k] + bodies.added_rot[k, b] * alb[k] * wb[k]
-        for k in range(start[b], start[b + 1]):
+        wb0, wb1, wb2 = rotate_back(r, w0, w1, w2)
+        varies = bodies.varies[b] != 0
+        if varies:
+            for i in range(n):
+                for j in range(i + 1):
+                    work[i, j] = bodies.mass0[b, i, j]
+        f0, f1, f2, m0, m1, m2, own = own_load(gravity, flow, bodies, pose, twist, b, t, r)
+        power += own
+        for k in range(start[b], start[b + 1]):   # each attachment's force less its centripetal part
             i = nodes[k]
-            p0, p1, p2 = rotate(r, arm[0, k], arm[1, k], arm[2, k])
-            e0, e1, e2 = cross(w0, w1, w2, p0, p1, p2)
-            t0, t1, t2 = cross(al0, al1, al2, p0, p1, p2)
-            n0, n1, n2 = cross(w0, w1, w2, e0, e1, e2)
-            k0, k1, k2 = a0 + t0 + n0, a1 + t1 + n1, a2 + t2 + n2
+            s0, s1, s2 = arm[0, k], arm[1, k], arm[2, k]
+            mi = bodies.attached_mass[k]
+            a_n, a_t = node_added[0, k], node_added[1, k]
+            g0, g1, g2 = rotate_back(r, mi * acc[0, i], mi * acc[1, i], mi * acc[2, i] if dim == 3 else 0.0)
+            e0, e1, e2 = cross(wb0, wb1, wb2, s0, s1, s2)
+            n0, n1, n2 = cross(wb0, wb1, wb2, e0, e1, e2)   # w x (w x s)
+            mn = mi + a_n
+            g0, g1, g2 = g0 - mn * n0, g1 - mn * n1, g2 - mn * n2
+            extra = a_t - a_n
+            if extra != 0.0:
+                q = node_tangent(x, i, around)
+                q0, q1, q2 = rotate_back(r, q[0], q[1], q[2])
+                bodies.tangent[0, k], bodies.tangent[1, k], bodies.tangent[2, k] = q0, q1, q2
+                along = extra * (q0 * n0 + q1 * n1 + q2 * n2)
+                g0, g1, g2 = g0 - along * q0, g1 - along * q1, g2 - along * q2
+                t0, t1, t2 = cross(s0, s1, s2, q0, q1, q2)   # u = (q, s x q) on the kept rows, in column 6
+                work[0, 6], work[1, 6] = q0, q1
+                if n == 3:
+                    work[2, 6] = t2
+                else:
+                    work[2, 6], work[3, 6], work[4, 6], work[5, 6] = q2, t0, t1, t2
+                for a in range(n):
+                    ua = extra * work[a, 6]
+                    for c in range(a + 1):
+                        work[a, c] += ua * work[c, 6]
+            h0, h1, h2 = cross(s0, s1, s2, g0, g1, g2)
+            f0, f1, f2, m0, m1, m2 = f0 + g0, f1 + g1, f2 + g2, m0 + h0, m1 + h1, m2 + h2
+        work[0, 6], work[1, 6] = f0, f1
+        if n == 3:
+            work[2, 6] = m2
+        else:
+            work[2, 6], work[3, 6], work[4, 6], work[5, 6] = f2, m0, m1, m2
+        if varies:
+            _ldl_factor(work, n)
+            _ldl_solve(work, n, work)
+        else:
+            _ldl_solve(bodies.factor[b], n, work)
+        if n == 3:   # 2-D: x, y and the turn about z
+            ab0, ab1, ab2, alb0, alb1, alb2 = work[0, 6], work[1, 6], 0.0, 0.0, 0.0, work[2, 6]
+        else:
+            ab0, ab1, ab2, alb0, alb1, alb2 = work[0, 6], work[1, 6], work[2, 6], work[3, 6], work[4, 6], work[5, 6]
+        out[0, b], out[1, b], out[2, b] = rotate(r, ab0, ab1, ab2)
+        out[3, b], out[4, b], out[5, b] = rotate(r, alb0, alb1, alb2)
+        # the fluid's inertial force on the body's own added mass: -A_t a . v - A_r alpha . w
+        vb0, vb1, vb2 = rotate_back(r, twist[0, b], twist[1, b], twist[2, b])
+        power -= bodies.added[0, b] * ab0 * vb0 + bodies.added[1, b] * ab1 * vb1 + bodies.added[2, b] * ab2 * vb2
+        power -= bodies.added_rot[0, b] * alb0 * wb0 + bodies.added_rot[1, b] * alb1 * wb1 + \
+            bodies.added_rot[2, b] * alb2 * wb2
+        for k in range(start[b], start[b + 1]):   # each attachment's acceleration a + alpha x s + w x (w x s)
+            i = nodes[k]
+            s0, s1, s2 = arm[0, k], arm[1, k], arm[2, k]
+            e0, e1, e2 = cross(wb0, wb1, wb2, s0, s1, s2)
+            t0, t1, t2 = cross(alb0, alb1, alb2, s0, s1, s2)
+            n0, n1, n2 = cross(wb0, wb1, wb2, e0, e1, e2)
+            kb0, kb1, kb2 = ab0 + t0 + n0, ab1 + t1 + n1, ab2 + t2 + n2
+            k0, k1, k2 = rotate(r, kb0, kb1, kb2)
             acc[0, i] = k0
             acc[1, i] = k1
             if dim == 3:
                 acc[2, i] = k2
             a_n, a_t = node_added[0, k], node_added[1, k]
             if a_n != 0.0 or a_t != 0.0:   # the fluid's inertial force -A_i a_i on the node, at its velocity
-                q0, q1, q2 = node_tangent(x, i, around)
-                along = k0 * q0 + k1 * q1 + k2 * q2
-                f0 = a_n * k0 + (a_t - a_n) * along * q0
-                f1 = a_n * k1 + (a_t - a_n) * along * q1
-                f2 = a_n * k2 + (a_t - a_n) * along * q2
-                power -= f0 * v[0, i] + f1 * v[1, i] + (f2 * v[2, i] if dim == 3 else 0.0)
+                h0, h1, h2 = a_n * kb0, a_n * kb1, a_n * kb2   # in body axes, with the tangent kept above
+                if a_t != a_n:
+                    q0, q1, q2 = bodies.tangent[0, k], bodies.tangent[1, k], bodies.tangent[2, k]
+                    along = (a_t - a_n) * (kb0 * q0 + kb1 * q1 + kb2 * q2)
+                    h0, h1, h2 = h0 + along * q0, h1 + along * q1, h2 + along * q2
+                u0, u1, u2 = rotate_back(r, v[0, i], v[1, i], v[2, i] if dim == 3 else 0.0)
+                power -= h0 * u0 + h1 * u1 + h2 * u2
     return power
 
 

@@ -96,7 +96,8 @@ def model_params(scene, layout: Layout) -> ModelParams:
     added = values[TERMS.index(ADDED_MASS_TERM)]
     groups = junctions(scene, layout.lines)
     points = junction_bundle(groups, added) if groups else no_junctions()
-    bodies = bodies_bundle(scene, point_ends(scene, layout.lines), added) if free_bodies(scene) else no_bodies()
+    ends = point_ends(scene, layout.lines)
+    bodies = bodies_bundle(scene, ends, added, layout.mass) if free_bodies(scene) else no_bodies()
     return ModelParams(1.0 / layout.mass, layout.node_length, line_table(layout.lines), around, points, bodies,
                        *values)
 
