@@ -159,9 +159,11 @@ def compile_all(methods: list[str] | None = None, scenes: list | None = None, st
                 family, shared, count = "statics", "", len(scenes)
             else:
                 method = METHODS[name]
-                for scene in scenes:
-                    warm_up(replace(scene, integrator=replace(scene.integrator, method=name)))
-                family, count = method.kind, len(scenes)
+                runs = [replace(scene, integrator=replace(scene.integrator, method=name)) for scene in scenes
+                        if method.moves_free_bodies or not any(b.kind == "free" for b in scene.rigid_bodies)]
+                for scene in runs:
+                    warm_up(scene)
+                family, count = method.kind, len(runs)
                 shared = first_of_family.setdefault(method.family, name)
                 shared = "" if shared == name else shared
             results.append(Compiled(name, family, time.perf_counter() - start, counter.functions - before, count,

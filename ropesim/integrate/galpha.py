@@ -91,6 +91,7 @@ class GeneralizedAlpha(Method):
     rho_inf: float = DEFAULT_RHO_INF
     unconditionally_stable = True
     starts_from_x_and_v = False
+    moves_free_bodies = False
 
     @property
     def family(self) -> type:
