@@ -22,7 +22,9 @@ accelerations (:func:`move_bodies`):
 
 The body's own forces: its weight -m g y at c; buoyancy rho V g y at its centre of buoyancy R c_B; drag on the
 velocity u = U(r) - v of the flow relative to the reference point, F = 1/2 rho R diag(CdA) R^T u |u|, and the
-rotational drag moment -1/2 rho R diag(Cd_r) R^T w |w| (MoorDyn's body drag, ``Body::doRHS``). The added mass
+rotational drag moment -1/2 rho R diag(Cd_r) R^T w |w| (MoorDyn's body drag, ``Body::doRHS``). Under a ``[sea]``
+:mod:`ropesim.model.body_sea` takes the drag's place: the buoyancy lost above the surface, the water's drag on
+the wet part (on the waves' velocity too) and the air's on the dry part, and the water's inertia force. The added mass
 acts on the accelerations alone: the velocity-dependent forces of potential flow on a body (the Munk moment) are
 left out, as MoorDyn leaves them out. The 6 x 6 matrix is symmetric positive definite (a body's own mass or inertia
 may be zero when its attachments carry it); in 2-D the body moves in x, y and turns about z, and the solve keeps
