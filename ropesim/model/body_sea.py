@@ -81,6 +81,26 @@ def submerged_fraction(y_cob, surface, height):
     return np.clip((np.asarray(surface) - np.asarray(y_cob)) / height + 0.5, 0.0, 1.0)
 
 
+def heave_stiffness(model, pose: np.ndarray, t: float) -> np.ndarray:
+    """Each free body's heave stiffness [N/m] at ``pose`` (7, B) and time t [s]: rho g A_wp = lift / h while the
+    surface cuts its walls, else 0 (and 0 everywhere without a sea or under MoorDyn's rule), as
+    :func:`water_at_body` has it; NumPy, for the static solver's step matrix."""
+    from .rotation import rotation_matrix
+    from .waves import wave_field
+
+    bundle, scene = model.params.bodies, model.scene
+    out = np.zeros(pose.shape[1])
+    if bundle is None or bundle.sea is None or scene.sea.fraction == "moordyn":
+        return out
+    field = wave_field(scene)
+    eta = field.elevation(pose[0], t, pose[2]) if field is not None else np.zeros_like(out)
+    turned = rotation_matrix(pose[3:7].T)                                   # (B, 3, 3)
+    y_cob = pose[1] + np.einsum("bj,jb->b", turned[:, 1, :], bundle.cob)
+    height = bundle.sea.rows[HEIGHT]
+    f = submerged_fraction(y_cob, scene.sea.level + eta, height)
+    return np.where((f > 0.0) & (f < 1.0), bundle.lift / height, 0.0)
+
+
 # ------------------------------------------------------------------------------------------ compiled
 
 
