@@ -299,3 +299,16 @@ def test_the_static_solver_floats_the_box_where_the_dynamics_keep_it():
     assert np.abs(p - p[0]).max() < 1e-9
     wet_weight = 10.0 * (2.0 - RHO * math.pi * 0.01 ** 2)           # kg: the whole chain's, in water
     assert -wet_weight / (RHO * 4.0) < p[0, 1] < -0.2 * wet_weight / (RHO * 4.0)
+
+
+def test_waves_given_from_outside_are_refused_with_a_free_body():
+    """A coupled program's wave kinematics come at the lines' nodes; a free body's reference point is not one."""
+    from ropesim.coupling import CouplingError
+
+    text = FLOAT.replace("METHOD", "rk4").replace("DT", "0.001")
+    text = text.replace('id = "anchor"\n', 'id = "anchor"\nkind = "coupled"\n')   # the program moves the anchor
+    coupling = ropesim.Coupling(ropesim.scene_from_toml(text, source="floating_box.toml"))
+    n = coupling.wave_points().shape[0]
+    with pytest.raises(CouplingError, match="floating_box: set_waves: a free rigid body") as info:
+        coupling.set_waves(np.zeros((n, 3)), np.zeros((n, 3)))
+    assert "\n" not in str(info.value)
