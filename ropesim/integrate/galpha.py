@@ -43,7 +43,6 @@ read off at the step's middle on the line through both (:func:`book`): second or
 from __future__ import annotations
 
 import math
-import os
 from collections import namedtuple
 from dataclasses import dataclass
 
@@ -69,7 +68,8 @@ from .sdirk import take_back_half, take_update
 DEFAULT_RHO_INF = 0.0
 NEWTON_TOL = 1e-9        # on the largest position update, times the shortest segment: a strain of 1e-9 (EA 1e-9,
 # 1.7 N on WD0050's chain; SDIRK2's 1e-11 cost galpha two to three more iterations a step at a mooring's steps)
-NEWTON_STRAIN = 1e-6
+NEWTON_STRAIN = 1e-6      # with adaptive steps Newton stops at a hundredth of the tolerance, but at most this strain
+# of the shortest segment (an unconverged solve is an error in every segment's force balance, EA times it)
 NEWTON_MAX_ITER = 60     # residual evaluations per step, halvings included
 RATE_REFACTOR = 0.1      # an update larger than this times the one before it: factor the matrix again (two
 # iterations' cost; at 0.25 a stale matrix crawled on at rates of 0.15 to 0.23 for ten iterations at WD0050's touchdown)
