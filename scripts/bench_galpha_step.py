@@ -1,7 +1,7 @@
 """What one galpha step costs on WD0050 (bench_moorings' case, MoorDyn's seabed law), part by part, against
 MoorDyn's RK2 step.
 
-    python scripts/bench_galpha_step.py [--tolerance 0.1] [--dt 0.0125] [--window 30] [--calls 2000] [--rho-inf R]
+    python scripts/bench_galpha_step.py [--tolerance 1] [--dt 0.1] [--window 30] [--calls 2000] [--rho-inf R]
         [--own-seabed]
 
 Times each compiled part of a step on the case's state at rest (the force evaluation with its residual, the
@@ -37,11 +37,11 @@ def main() -> int:
     from ropesim.model.build import build
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--tolerance", type=float, default=0.1)
-    parser.add_argument("--dt", type=float, default=0.0125)
+    parser.add_argument("--tolerance", type=float, default=1.0)
+    parser.add_argument("--dt", type=float, default=0.1)
     parser.add_argument("--window", type=float, default=30.0)
     parser.add_argument("--calls", type=int, default=2000)
-    parser.add_argument("--rho-inf", type=float, default=None)
+    parser.add_argument("--rho-inf", type=float, default=0.0, help="galpha's rho_inf (0: the setting for moorings)")
     parser.add_argument("--own-seabed", action="store_true",
                         help="ropesim's own seabed damping (into the plane only, ramped in) instead of MoorDyn's")
     args = parser.parse_args()

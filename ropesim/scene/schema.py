@@ -810,7 +810,7 @@ class Integrator:
     method: str = spec("str", "integration method", default="symplectic_euler",
                        choices=("symplectic_euler", "verlet", "yoshida4", "pefrl", "rk4", "sdirk2", "galpha"))
     rho_inf: float | None = spec("float", "galpha's spectral radius at infinite step: 1 keeps every mode's "
-                                 "energy, 0 damps the highest out in one step (default 0)", default=None,
+                                 "energy, 0 damps the highest out in one step (default 0.9)", default=None,
                                  required=False, low=0, high=1)
     tolerance: float | None = spec("float", "galpha's error tolerance: adaptive steps, each step's estimated error "
                                    "at most this; dt is then the grid x and v are reported on", "m", default=None,
