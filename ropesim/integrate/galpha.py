@@ -543,7 +543,7 @@ def advance_adaptive(state, work, newton, co, held, nodes, params, limits, sched
     for s in range(schedule.n_steps):
         done = schedule.step0 + s + 1
         target = done * schedule.h if done < schedule.total_steps else t_end
-        framed = due(done, schedule)
+        framed = done % schedule.save_every == 0 or done == schedule.total_steps   # a frame is saved at target
         while clock[T1] < target * (1.0 - 1e-13):
             t = clock[T1]
             planned = min(clock[H_NEXT], t_end - t)
