@@ -1,8 +1,9 @@
 """What one galpha step costs on WD0050 (bench_moorings' case, MoorDyn's seabed law), part by part, against
 MoorDyn's RK2 step.
 
-    python scripts/bench_galpha_step.py [--tolerance 0.1] [--dt 0.0125] [--window 30] [--calls 2000] [--rho-inf R]
+    python scripts/bench_galpha_step.py [--tolerance 1] [--dt 0.1] [--window 30] [--calls 2000] [--rho-inf R]
         [--own-seabed]
+    python scripts/bench_galpha_step.py --seabed-effect 0.0025   # the two-way damping's regularisation
 
 Times each compiled part of a step on the case's state at rest (the force evaluation with its residual, the
 matrix's assembly and factorisation, a solve with the factored matrix), then runs the case with adaptive steps
@@ -37,14 +38,19 @@ def main() -> int:
     from ropesim.model.build import build
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--tolerance", type=float, default=0.1)
-    parser.add_argument("--dt", type=float, default=0.0125)
+    parser.add_argument("--tolerance", type=float, default=1.0)
+    parser.add_argument("--dt", type=float, default=0.1)
     parser.add_argument("--window", type=float, default=30.0)
     parser.add_argument("--calls", type=int, default=2000)
-    parser.add_argument("--rho-inf", type=float, default=None)
+    parser.add_argument("--rho-inf", type=float, default=0.0, help="galpha's rho_inf (0: the setting for moorings)")
     parser.add_argument("--own-seabed", action="store_true",
                         help="ropesim's own seabed damping (into the plane only, ramped in) instead of MoorDyn's")
+    parser.add_argument("--seabed-effect", type=float, metavar="DT",
+                        help="instead: the fairlead tension of galpha at fixed steps DT with MoorDyn's two-way "
+                             "damping grown in (galpha's) and as MoorDyn has it, against each other and rk4")
     args = parser.parse_args()
+    if args.seabed_effect:
+        return seabed_effect(args.seabed_effect, args.window, args.rho_inf)
     SEABED["both_ways"] = not args.own_seabed
     case, start = problem()
 
@@ -100,6 +106,53 @@ def main() -> int:
               f"solves {its * parts['solve (factored)']:.3f} s, factorisations {fac * parts['assembly + factorisation']:.3f} s")
         if report["steps_taken"]:
             print(f"  mean step {args.window / report['steps_taken'] * 1e3:.2f} ms")
+    return 0
+
+
+def seabed_effect(dt: float, window: float, rho_inf: float | None) -> int:
+    """The regularisation's effect on the answer: WD0050 with galpha at fixed ``dt``, MoorDyn's two-way seabed
+    damping grown in over delta_d (what galpha runs) and at full strength from first contact (MoorDyn's law,
+    which every other method runs), RMS of their fairlead tensions' difference over the range of rk4's."""
+    import tomli_w
+
+    import ropesim
+    from bench_moorings import DT_OUT, SURGE, problem, reference
+    from references.moordyn_own_cases import chain_scene_dict, differences
+    from ropesim.model.forces import seabed
+
+    case, start = problem()
+    own = seabed.SEABED_TERM.params
+
+    def moordyns(scene, layout):   # the both-ways flag 1 (MoorDyn's law) where galpha's would be 2
+        bed, area = own(scene, layout)
+        bed = bed.copy()
+        bed[10] = min(bed[10], 1.0)
+        return bed, area
+
+    def fairlead(law):
+        object.__setattr__(seabed.SEABED_TERM, "params", law)
+        try:
+            scene = chain_scene_dict(case, start, method="galpha", dt=dt, t_end=window, interval=DT_OUT,
+                                     dimension=3, both_ways=True, surge=SURGE)
+            if rho_inf is not None:
+                scene["integrator"]["rho_inf"] = rho_inf
+            traj = ropesim.simulate(ropesim.scene_from_toml(tomli_w.dumps(scene)))
+        finally:
+            object.__setattr__(seabed.SEABED_TERM, "params", own)
+        if traj.summary["status"] != "completed":
+            return None
+        import numpy as np
+
+        return np.abs(np.asarray(traj.tension)[:, -1])
+
+    ref, info = reference(case, start, window)
+    grown, full = fairlead(own), fairlead(moordyns)
+    print(f"WD0050, galpha at {dt:g} s (rho_inf {rho_inf}), {window:g} s; reference {info}")
+    for name, run in (("grown in (galpha's)", grown), ("MoorDyn's, full from contact", full)):
+        print(f"  {name:30s} " + (f"{differences(ref, run)['rms_of_range']:.2e} of the range from rk4"
+                                  if run is not None else "Newton failed"))
+    if grown is not None and full is not None:
+        print(f"  the two laws apart: {differences(full, grown)['rms_of_range']:.2e} of the range")
     return 0
 
 

@@ -1,10 +1,13 @@
 """Generalized-alpha with adaptive steps: a local error estimate, step-size control and dense output.
 
 With ``integrator.tolerance`` (tol, metres) the steps are the scheme's own choice; the run's time grid (steps of
-``integrator.dt``) becomes the grid on which x and v are reported, each grid point read off the step that
-covers it by dense output, a cubic Hermite interpolant of the step's ends (x, v): its error, O(H^4) in x and
-O(H^3) in v, is below the scheme's own second-order error. A step may span many grid points or a grid interval
-many steps; dt costs an interpolation per grid point, not a solve.
+``integrator.dt``) becomes the grid on which x and v are reported. The saved frames are step ends: a step that
+would pass a frame's time is cut to land on it (:func:`land`; the step after it is the controller's own again),
+because a stiff line's tension is EA times its strain, and positions interpolated between two solved steps are
+not in force balance (on WD0050 a frame read off by interpolation from 30 ms steps carried a fairlead tension
+error of 6 % of its range, the frames at step ends 0.2 %). The other grid points are read off the step that
+covers them by dense output, a cubic Hermite interpolant of the step's ends (x, v): its error, O(H^4) in x and
+O(H^3) in v, is below the scheme's own second-order error.
 
 **The error estimate** is the scheme's own truncation term (Zienkiewicz & Xie 1991 for Newmark, carried over
 to generalized-alpha): the displacement's local error is h^3 x''' (beta - 1/6 + (am - af) / 2) + O(h^4) (the
@@ -26,7 +29,10 @@ local-error control lets an oscillating line's phase error add up over the run (
 true error 20 to 200 times a per-step tolerance). summary.json reports that sum ("estimated_error_m"). The
 next step is 0.9 h / ratio^(1/2) (the ratio grows as h^2), within 0.2 and 2 times h; a step within 20 % of the last is not changed, so
 that the factored matrix stays valid (modified Newton). A rejected step, or one whose Newton solve fails, is
-retried at the smaller step. Newton's tolerance becomes a hundredth of tol.
+retried at the smaller step. Newton's tolerance becomes a hundredth of tol, but at most a strain of 1e-6 of the
+shortest segment (NEWTON_STRAIN in :mod:`ropesim.integrate.galpha`): an unconverged Newton solve is not a
+smooth position error but an error in the force balance, EA times it in each segment (at tol = 1 m the
+hundredth alone, 1 cm, left WD0050's fairlead tension 5 % off).
 
 The energy ledger is booked per step and read off at each grid point on the line between the step's ends.
 Everything the loop keeps between calls (the step's ends, the step, counts and estimates) is state, so a run
@@ -136,6 +142,17 @@ def dense_output(adapt, t, x, v, ledger):
                 v[d, i] = v1[d, i]
     for k in range(ledger.shape[0]):
         ledger[k] = adapt.ledger0[k] + th * (adapt.ledger1[k] - adapt.ledger0[k])
+
+
+@jit.kernel
+def land(h, left):
+    """The step that lands on a frame ``left`` seconds ahead: all of it when the planned step ``h`` reaches it,
+    half of it when two steps of ``h`` would (no sliver of a step after a full one), else ``h``."""
+    if left <= h * (1.0 + 1e-9):
+        return left
+    if left < 2.0 * h:
+        return 0.5 * left
+    return h
 
 
 @jit.kernel
