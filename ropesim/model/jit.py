@@ -1,13 +1,16 @@
 """How ropesim compiles its kernels: one decorator for every compiled function, and compile-time switches.
 
 ``kernel`` (used as ``@jit.kernel``, the module named at every use so that a reader, and
-``../shared/tools/shape.py``, sees a compiled function) is Numba's ``njit`` in nopython mode with three
+``../shared/tools/shape.py``, sees a compiled function) is Numba's ``njit`` in nopython mode with four
 settings fixed for the whole code base:
 
 - ``cache=True``: compiled machine code is kept on disk (see :mod:`ropesim.io.numba_cache`), so only the
   first run of a scene's methods compiles;
 - ``error_model="numpy"``: a division by zero gives inf or nan, as in NumPy, instead of raising (the blow-up
   check then stops the run, and the loops need no zero tests);
+- no C wrapper (``no_cfunc_wrapper``): Numba would lower, optimise and emit one for every function, for its
+  use as a first-class function or C callback, which no kernel is (:class:`Kernel` drops the CPython wrapper
+  too, for the kernels only kernels call);
 - no reference counting (Numba's private ``_nrt=False``). Numba counts references to every array a compiled
   function receives: an atomic increment on entry and a decrement on exit, per array and per call. The
   force terms receive the model's parameter bundle (some twenty arrays) several times per stage, so the
@@ -52,7 +55,7 @@ from numba import njit
 from numba.core import types as numba_types
 from numba.core.registry import CPUDispatcher
 
-OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False}
+OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False, "no_cfunc_wrapper": True}
 
 
 def kernel(function=None, *, inline: str = "never", literal_integers: bool = True):
@@ -96,7 +99,7 @@ class Kernel(CPUDispatcher):
                                        function.__defaults__, function.__closure__)
             clone.__qualname__ = function.__qualname__ + INTERNAL_SUFFIX
             clone.__module__, clone.__doc__ = function.__module__, function.__doc__
-            twin = njit(no_cpython_wrapper=True, no_cfunc_wrapper=True, **OPTIONS)(clone)
+            twin = njit(no_cpython_wrapper=True, **OPTIONS)(clone)
             twin.ropesim_template = template_of(self)
             self.__dict__["ropesim_internal"] = twin
         return twin
