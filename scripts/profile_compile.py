@@ -10,6 +10,12 @@ the functions compiled at the top level (what the run asked for) and the LLVM sh
 
     python scripts/profile_compile.py mooring_chain
     python scripts/profile_compile.py helicopter_mass --set integrator.method=sdirk2
+    python scripts/profile_compile.py mooring_chain --passes
+
+``--passes`` adds where the compile goes by stage, summed over every function: each of Numba's compiler
+passes (type inference, lowering to LLVM IR, ...), the wrappers Numba lowers for calls from Python, and
+LLVM's stages (function passes, each library's final module, machine-code emission), each stage's own CPU
+seconds (what a nested stage spent left out, so the rows add up to the compile).
 
 Figures are CPU seconds of one process: compare them with each other, or with another revision's in the
 same load (``scripts/bench_first_run.py`` measures whole first runs against another revision).
@@ -32,6 +38,7 @@ def main() -> None:
                         help="a scene override, as `ropesim run --set` (repeatable)")
     parser.add_argument("--t-end", default="0.01", help="the run's end time [s] (default: 0.01, a few steps)")
     parser.add_argument("--top", type=int, default=40, help="functions listed (default: 40)")
+    parser.add_argument("--passes", action="store_true", help="also CPU seconds per compiler pass and LLVM stage")
     args = parser.parse_args()
 
     work = tempfile.mkdtemp(prefix="ropesim-compile-profile-")
@@ -66,6 +73,7 @@ def main() -> None:
 
     event.register("numba:compile", Compiles())
     event.register("numba:llvm_lock", Llvm())
+    stages = time_stages() if args.passes else {}
     from ropesim.cli import main as ropesim_main
 
     command = ["run", args.scene, "--set", f"integrator.t_end={args.t_end}", "--out", os.path.join(work, "run"),
@@ -90,6 +98,48 @@ def main() -> None:
     print("compiled at the top level (what the run called):")
     for name, seconds in top:
         print(f"{seconds:7.2f}  {name}")
+    if stages:
+        print("by stage (own CPU seconds, summed over every function):")
+        for name, seconds in sorted(stages.items(), key=lambda item: -item[1])[:args.top]:
+            print(f"{seconds:7.2f}  {name}")
+
+
+def time_stages() -> dict:
+    """Wrap Numba's compiler passes, the wrappers' lowering and its code library's LLVM stages to sum each one's
+    own CPU seconds (a stage nested in another, such as a callee's compile inside its caller's type inference,
+    is left out of the outer one) into the dict returned, filled as the run compiles."""
+    from numba.core import codegen, compiler_machinery, lowering
+
+    own, stack = {}, []
+
+    def timed(name, method):
+        def run(*args, **kwargs):
+            stack.append([time.process_time(), 0.0])
+            try:
+                return method(*args, **kwargs)
+            finally:
+                start, nested = stack.pop()
+                spent = time.process_time() - start
+                own[name] = own.get(name, 0.0) + spent - nested
+                if stack:
+                    stack[-1][1] += spent
+        return run
+
+    run_pass = compiler_machinery.PassManager._runPass
+
+    def _runPass(self, index, pss, state):
+        return timed(f"pass {pss.name()}", run_pass)(self, index, pss, state)
+
+    compiler_machinery.PassManager._runPass = _runPass
+    for cls, method, name in [
+            (lowering.Lower, "create_cpython_wrapper", "lowering the CPython wrapper"),
+            (lowering.Lower, "create_cfunc_wrapper", "lowering the C wrapper"),
+            (codegen.CPUCodeLibrary, "add_ir_module", "LLVM IR text parsed"),
+            (codegen.CPUCodeLibrary, "_optimize_functions", "LLVM function passes"),
+            (codegen.CPUCodeLibrary, "_optimize_final_module", "LLVM final module (callees linked in)"),
+            (codegen.JITCodeLibrary, "_finalize_specific", "LLVM machine code")]:
+        setattr(cls, method, timed(name, getattr(cls, method)))
+    return own
 
 
 if __name__ == "__main__":

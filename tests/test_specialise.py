@@ -80,11 +80,40 @@ def test_each_copy_computes_with_its_switches_and_is_made_once():
                                                                                                frozenset())
 
 
-def test_integer_constants_passed_to_a_kernel_compile_it_once():
+def test_integer_constants_passed_to_a_kernel_compile_it_once(tmp_path):
     """A kernel called from compiled code with three integer constants compiles once (Numba alone compiles it
     for each constant, as a literal: a driven body's motion law seven times), and computes the same."""
-    assert sample.first_three(np.array([1.0, 2.0, 4.0, 8.0])) == 7.0
-    assert [str(s) for s in sample.element.signatures] == ["(Array(float64, 1, 'C', False, aligned=True), int64)"]
+    code = """
+        import numpy as np
+        import specialise_sample as sample
+        value = sample.first_three(np.array([1.0, 2.0, 4.0, 8.0]))
+        twin = sample.element.internal   # what a call from compiled code compiles (jit.Kernel)
+        print(json.dumps([value, [str(s) for s in twin.signatures], sample.element.signatures]))
+    """
+    value, signatures, python_signatures = _probe(code, tmp_path / "cache")
+    assert value == 7.0
+    assert signatures == ["(Array(float64, 1, 'C', False, aligned=True), int64)"] and python_signatures == []
+
+
+def test_a_kernel_called_from_compiled_code_compiles_without_wrappers_and_python_still_calls_it(tmp_path):
+    """A kernel first compiled for another kernel's call compiles its wrapper-less twin (jit.Kernel.internal)
+    and a later call from Python compiles the kernel itself; a kernel compiled for Python first is what a
+    compiled caller links, without a second compile. Both orders compute the same."""
+    twin = sample.element.internal
+    assert twin.targetoptions["no_cpython_wrapper"] and twin.targetoptions["no_cfunc_wrapper"]
+    assert jit.template_name(twin.py_func.__qualname__) == "element" and jit.template_of(twin) is sample.element
+    code = """
+        import numpy as np
+        import specialise_sample as sample
+        a = np.array([1.0, 2.0, 4.0, 8.0])
+        calls = [lambda: sample.first_three(a), lambda: sample.element(a, 3)]
+        values = [call() for call in (calls if sys.argv[1:] == ["caller"] else calls[::-1])]
+        print(json.dumps([sorted(values), [n.rsplit(".", 1)[-1] for n in compiled]]))
+    """
+    caller_first = _probe(code.replace("sys.argv[1:]", "['caller']"), tmp_path / "one")
+    assert caller_first == [[7.0, 8.0], ["first_three", "element__i", "element"]]
+    python_first = _probe(code.replace("sys.argv[1:]", "['python']"), tmp_path / "two")
+    assert python_first == [[7.0, 8.0], ["element", "first_three"]]
 
 
 def test_a_template_cannot_run_unspecialised():
@@ -106,12 +135,12 @@ def test_a_switched_off_kernel_is_never_compiled_and_copies_load_from_the_cache(
     cache = tmp_path / "cache"
     first = _probe(code.replace("sys.argv[1:]", "[]"), cache)
     assert first[0] == 3.0
-    names = [name.rsplit(".", 1)[-1] for name in first[1]]
+    names = [jit.template_name(name.rsplit(".", 1)[-1]) for name in first[1]]
     assert "squares" not in names and "cubes" not in names and jit.template_name(names[0]) == "total"
     squares = _probe(code.replace("sys.argv[1:]", "['sample_squares']"), cache)
     assert squares[0] == 3.0 + 5.0
-    assert "squares" in [n.rsplit(".", 1)[-1] for n in squares[1]]
-    assert "cubes" not in [n.rsplit(".", 1)[-1] for n in squares[1]]
+    assert "squares" in [jit.template_name(n.rsplit(".", 1)[-1]) for n in squares[1]]
+    assert "cubes" not in [jit.template_name(n.rsplit(".", 1)[-1]) for n in squares[1]]
     again = _probe(code.replace("sys.argv[1:]", "[]"), cache)
     assert again == [3.0, []]   # loaded from Numba's cache in a new process: nothing compiles
 

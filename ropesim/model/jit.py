@@ -1,13 +1,16 @@
 """How ropesim compiles its kernels: one decorator for every compiled function, and compile-time switches.
 
 ``kernel`` (used as ``@jit.kernel``, the module named at every use so that a reader, and
-``../shared/tools/shape.py``, sees a compiled function) is Numba's ``njit`` in nopython mode with three
+``../shared/tools/shape.py``, sees a compiled function) is Numba's ``njit`` in nopython mode with four
 settings fixed for the whole code base:
 
 - ``cache=True``: compiled machine code is kept on disk (see :mod:`ropesim.io.numba_cache`), so only the
   first run of a scene's methods compiles;
 - ``error_model="numpy"``: a division by zero gives inf or nan, as in NumPy, instead of raising (the blow-up
   check then stops the run, and the loops need no zero tests);
+- no C wrapper (``no_cfunc_wrapper``): Numba would lower, optimise and emit one for every function, for its
+  use as a first-class function or C callback, which no kernel is (:class:`Kernel` drops the CPython wrapper
+  too, for the kernels only kernels call);
 - no reference counting (Numba's private ``_nrt=False``). Numba counts references to every array a compiled
   function receives: an atomic increment on entry and a decrement on exit, per array and per call. The
   force terms receive the model's parameter bundle (some twenty arrays) several times per stage, so the
@@ -52,7 +55,7 @@ from numba import njit
 from numba.core import types as numba_types
 from numba.core.registry import CPUDispatcher
 
-OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False}
+OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False, "no_cfunc_wrapper": True}
 
 
 def kernel(function=None, *, inline: str = "never", literal_integers: bool = True):
@@ -61,15 +64,62 @@ def kernel(function=None, *, inline: str = "never", literal_integers: bool = Tru
     ``literal_integers=False``: compiled once for integer constants (:class:`PlainIntegers`)."""
     def decorate(fn):
         dispatcher = njit(inline=inline, **OPTIONS)(fn)
-        if not literal_integers:
-            dispatcher.__class__ = PlainIntegers
+        if inline == "never":   # an inlined helper is never compiled for a kernel's call: no twin needed
+            dispatcher.__class__ = PlainIntegers if not literal_integers else Kernel
         dispatcher.ropesim_inline = inline   # for specialise's copies (Numba keeps no record of the jit options)
         return dispatcher
 
     return decorate(function) if function is not None else decorate
 
 
-class PlainIntegers(CPUDispatcher):
+INTERNAL_SUFFIX = "__i"
+"""Appended to a kernel's qualified name for its :attr:`Kernel.internal` twin (its own entry in Numba's cache)."""
+
+
+class Kernel(CPUDispatcher):
+    """Numba's dispatcher for a kernel that other kernels call: a call from compiled code goes to an internal twin
+    compiled without Numba's two wrappers, unless this dispatcher already has the call's types compiled.
+
+    Numba gives every function it compiles a CPython wrapper (unboxing each argument from Python objects: some
+    140 values for a bundle of twenty arrays) and a C wrapper, lowers them to LLVM IR, optimises them and emits
+    their machine code, and does so again in every caller its library is linked into, only to discard them
+    there. Only a kernel called from Python needs them. A kernel's first compile for a call from another kernel
+    therefore compiles :attr:`internal`, a copy of the same function (same code, same globals) under the name
+    ``<qualname>__i`` with ``no_cpython_wrapper`` and ``no_cfunc_wrapper`` set: the machine code of its body
+    is the same, and its cache entry is its own, so a process never finds a wrapper-less copy when Python calls
+    the kernel. ``mooring_chain``'s first run: about 2.5 s of CPU less of 17 (``scripts/profile_compile.py``,
+    see the performance log). A kernel compiled for Python first is linked as it is (one compile, not two)."""
+
+    @property
+    def internal(self):
+        twin = self.__dict__.get("ropesim_internal")
+        if twin is None:
+            function = self.py_func
+            clone = types.FunctionType(function.__code__, function.__globals__, function.__name__,
+                                       function.__defaults__, function.__closure__)
+            clone.__qualname__ = function.__qualname__ + INTERNAL_SUFFIX
+            clone.__module__, clone.__doc__ = function.__module__, function.__doc__
+            twin = njit(no_cpython_wrapper=True, **OPTIONS)(clone)
+            twin.ropesim_template = template_of(self)
+            self.__dict__["ropesim_internal"] = twin
+        return twin
+
+    def _target(self, args):
+        """Who compiles a call from compiled code with argument types ``args``: this dispatcher when it has them
+        compiled already (for Python), else its internal twin."""
+        return self if tuple(args) in self.overloads else self.internal
+
+    def get_call_template(self, args, kws):
+        target = self._target(self._compiler.fold_argument_types(args, kws)[1])
+        return super().get_call_template(args, kws) if target is self else target.get_call_template(args, kws)
+
+    def get_overload(self, sig):
+        args = sig if isinstance(sig, tuple) else sig.args
+        target = self._target(args)
+        return super().get_overload(sig) if target is self else target.get_overload(sig)
+
+
+class PlainIntegers(Kernel):
     """Numba's dispatcher, but a call from compiled code passes a constant integer as a plain integer.
 
     Numba types an integer constant argument (``offset(m, j, 3, t)``) as a literal, and compiles the callee
@@ -105,7 +155,7 @@ Switches = frozenset
 
 _reads: dict = {}
 _copies: dict = {}
-COPY_SUFFIX = re.compile(r"__s[0-9a-f]+$")
+COPY_SUFFIX = re.compile(r"(__s[0-9a-f]+)?(__i)?$")
 
 
 LOAD_GLOBAL, EXTENDED_ARG = dis.opmap["LOAD_GLOBAL"], dis.EXTENDED_ARG
