@@ -24,7 +24,11 @@ as in SDIRK2; a body's six unknowns (its reference point and a rotation vector o
 the nodes are (:mod:`ropesim.integrate.galpha_bodies`).
 
 Modified Newton: the matrix is factored when the step size changes or when Newton converges slowly (an update
-not smaller than RATE_REFACTOR times the one before it), and is otherwise reused, across steps too. A full update
+not smaller than RATE_REFACTOR times the one before it), and is otherwise reused, across steps too. A free body's
+updates are watched on their own (its block goes stale as it turns): one above BODY_RATE_REFACTOR times the body's
+last is not convergence, and factors the matrix again. Without that, the stale block's few 1e-15 m of error a
+step, divided by beta_v into the body's velocities, added up over many small steps (the tumbling tripod at
+78 us: its angular velocity 1.1e-6 rad/s off after 0.1 s, 6e-8 with it, near a fresh matrix every step). A full update
 that raises the residual (a contact switching on, a segment going slack) is halved (a backtracking line search).
 The non-smooth terms are not regularised beyond what the force terms already do (the seabed's onset and the
 friction have their own smoothing lengths, see the seabed's docs); compressive geometric stiffness is left out of
