@@ -23,16 +23,16 @@ banded and a system's points and free rigid bodies are joined by a Schur complem
 as in SDIRK2; a body's six unknowns (its reference point and a rotation vector on its orientation) are stepped as
 the nodes are (:mod:`ropesim.integrate.galpha_bodies`).
 
-Modified Newton: the matrix is factored when the step size changes or when Newton converges slowly (an update
-not smaller than RATE_REFACTOR times the one before it), and is otherwise reused, across steps too. A free body's
-updates are watched on their own (its block goes stale as it turns): one above BODY_RATE_REFACTOR times the body's
-last is not convergence, and factors the matrix again. Without that, the stale block's few 1e-15 m of error a
-step, divided by beta_v into the body's velocities, added up over many small steps (the tumbling tripod at
-78 us: its angular velocity 1.1e-6 rad/s off after 0.1 s, 6e-8 with it, near a fresh matrix every step). A full update
-that raises the residual (a contact switching on, a segment going slack) is halved (a backtracking line search).
-The non-smooth terms are not regularised beyond what the force terms already do (the seabed's onset and the
-friction have their own smoothing lengths, see the seabed's docs); compressive geometric stiffness is left out of
-the matrix as in SDIRK2.
+Modified Newton: the matrix is factored when the step size changes or when Newton converges slowly (an update not
+smaller than RATE_REFACTOR times the one before it), and is otherwise reused, across steps too. A free body's
+updates are watched on their own (its block goes stale as it turns): with a matrix from an earlier step, one above
+BODY_RATE_REFACTOR times the body's last is not convergence, and factors the matrix again. Without that, the stale
+block's few 1e-15 m of error a step, divided by beta_v into the body's velocities, added up over many small steps
+(the tumbling tripod at 78 us: its angular velocity 1.1e-6 rad/s off after 0.1 s, 6e-8 with it, near a fresh matrix
+every step). A full update that raises the residual (a contact switching on, a segment going slack) is halved (a
+backtracking line search). The non-smooth terms are not regularised beyond what the force terms already do (the
+seabed's onset and the friction have their own smoothing lengths, see the seabed's docs); compressive geometric
+stiffness is left out of the matrix as in SDIRK2.
 
 The energy ledger books each step's flows from their powers at this step's and the last step's force points,
 read off at the step's middle on the line through both (:func:`book`): second order for every rho_inf.
@@ -396,6 +396,7 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats):
     stride = 0.0
     previous = 0.0
     turning = 0.0   # the bodies' last update (their points' largest displacement [m]): its own rate
+    refreshed = False   # the matrix factored in this step
     halvings = 0
     for it in range(NEWTON_MAX_ITER):
         norm, fluid, internal, seabed = residual(work, rhs, c2, beta_v, t_f, held, nodes, params, newton.body,
@@ -418,6 +419,7 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats):
             control[FACTORED_H] = h
             stats[FACTORISATIONS] += 1
             refactor = False
+            refreshed = True
         if WITH_JUNCTIONS or WITH_BODIES:
             schur_solve(band, newton.jac.w, params.lines, newton.groups, rhs)
         else:
@@ -427,7 +429,8 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats):
         slow_body = False
         if WITH_BODIES:
             moved = max(take_body_update(newton.body.stage, newton.groups), rotation_stride(newton.body))
-            slow_body = turning > 0.0 and moved > BODY_RATE_REFACTOR * turning and moved > newton.tol * 1e-3
+            slow_body = (not refreshed and turning > 0.0 and moved > BODY_RATE_REFACTOR * turning
+                         and moved > newton.tol * 1e-3)
             turning = moved
             stride = max(stride, moved)
         stats[ITERATIONS] += 1
