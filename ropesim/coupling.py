@@ -341,6 +341,10 @@ class Coupling:
         from .model.forces.sea import GIVEN, GIVEN_WAVES, STATE_VALID
 
         self._need_sea("set_waves")
+        if self.model.params.bodies is not None:
+            raise CouplingError(f"{self.scene.name}: set_waves: a free rigid body takes the water at its reference "
+                                f"point, which the wave points (the lines' nodes) do not give; its waves come from "
+                                f"the scene's [waves]")
         n, dim = self.model.nodes, self.model.dim
         u = self._node_values(velocity, (n, dim), "velocity")
         a = self._node_values(acceleration, (n, dim), "acceleration")

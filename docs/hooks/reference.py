@@ -120,6 +120,7 @@ WHEN_ABSENT = {
     "bodies.center_of_gravity": "the body's reference point",
     "bodies.inertia": "none (**required** for a free body)",
     "bodies.center_of_buoyancy": "the body's reference point",
+    "bodies.height": "none (**required** for a free body under a `[sea]`, unless `fraction = \"moordyn\"`)",
     "bodies.cd_area": "zero",
     "bodies.cd_rotation": "zero",
     "bodies.added_mass": "zero",

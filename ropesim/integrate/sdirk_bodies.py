@@ -27,7 +27,9 @@ its centre of gravity, its buoyancy at its centre of buoyancy, each attachment's
 :mod:`ropesim.model.body_groups`), and D = -dF/dW: the gyroscopic moment's [w]x I - [I w]x, the centripetal
 forces' -M_p ([w x p]x + [w]x [p]x) at each mass's arm p, and the drag's and rotational drag's
 R diag(d) (|u| I + u u^T / |u|) R^T and a free body's linear damper diag(c) on its translation; K_s = diag(k)
-its linear spring's. Left out: the dependence of the centripetal and drag terms on the orientation
+its linear spring's. Under a sea (:mod:`ropesim.model.body_sea`) the drag's rate is the water's share f on the
+velocity relative to the water plus the air's on the velocity relative to the wind, and K_s takes the
+waterplane's heave stiffness rho g A_wp while the surface cuts the body's walls. Left out: the dependence of the centripetal and drag terms on the orientation
 (O(beta^2 w^2)), which only slows Newton's convergence, never changes its solution.
 
 Stored in :class:`BodyStage`; everything here runs behind the bodies switch.
@@ -43,6 +45,7 @@ import numpy as np
 from ..model import jit
 from ..model.bodies import _add_mass_at, body_attachments_system, body_own_system, place_attachments
 from ..model.body_groups import body_unknowns, kept_rows, set_body_arms
+from ..model.body_sea import WITH_BODY_SEA, sea_rates
 from ..model.forces.fluid import WITH_FLOW, flow_at, node_tangent
 from ..model.forces.gravity import WITH_GRAVITY
 from ..model.rotation import cross, matrix_of, rotate_back, turn
@@ -252,17 +255,31 @@ def stage_rows(body, X, acc, beta, damp, t, p, groups, rhs):
         own[5, 3] += damp * i1
         own[5, 4] -= damp * i0
         # drag on the flow relative to the reference point, and the rotational drag
-        u0, u1, u2 = -twist[0, b], -twist[1, b], -twist[2, b]
-        if WITH_FLOW:
-            U0, U1, U2 = flow_at(pose[1, b], t, p.flow[0], p.flow[1])
-            u0 += U0
-            u1 += U1
-            u2 += U2
-        ub = rotate_back(r, u0, u1, u2)
-        _add_drag_rate(own, 0, r, bodies.drag[0, b], bodies.drag[1, b], bodies.drag[2, b], ub[0], ub[1], ub[2], damp)
-        wb = rotate_back(r, w0, w1, w2)
-        _add_drag_rate(own, 3, r, bodies.drag_rot[0, b], bodies.drag_rot[1, b], bodies.drag_rot[2, b], wb[0], wb[1],
-                       wb[2], damp)
+        if WITH_BODY_SEA:   # under a sea: the water's share and the air's, and the waterplane's heave stiffness
+            heave, wet, dry, u0, u1, u2, air0, air1, air2 = sea_rates(p.flow, bodies, pose, twist, b, t, r)
+            own[1, 1] += beta * damp * heave
+            ub = rotate_back(r, u0, u1, u2)
+            _add_drag_rate(own, 0, r, bodies.drag[0, b], bodies.drag[1, b], bodies.drag[2, b], ub[0], ub[1], ub[2],
+                           damp * wet)
+            ub = rotate_back(r, air0, air1, air2)
+            _add_drag_rate(own, 0, r, bodies.drag[0, b], bodies.drag[1, b], bodies.drag[2, b], ub[0], ub[1], ub[2],
+                           damp * dry)
+            wb = rotate_back(r, w0, w1, w2)
+            _add_drag_rate(own, 3, r, bodies.drag_rot[0, b], bodies.drag_rot[1, b], bodies.drag_rot[2, b], wb[0],
+                           wb[1], wb[2], damp * (wet + dry))
+        else:
+            u0, u1, u2 = -twist[0, b], -twist[1, b], -twist[2, b]
+            if WITH_FLOW:
+                U0, U1, U2 = flow_at(pose[1, b], t, p.flow[0], p.flow[1])
+                u0 += U0
+                u1 += U1
+                u2 += U2
+            ub = rotate_back(r, u0, u1, u2)
+            _add_drag_rate(own, 0, r, bodies.drag[0, b], bodies.drag[1, b], bodies.drag[2, b], ub[0], ub[1], ub[2],
+                           damp)
+            wb = rotate_back(r, w0, w1, w2)
+            _add_drag_rate(own, 3, r, bodies.drag_rot[0, b], bodies.drag_rot[1, b], bodies.drag_rot[2, b], wb[0],
+                           wb[1], wb[2], damp)
         # the linear spring and damper on the reference point: beta^2 k + beta c on its translation
         for a in range(3):
             if bodies.spring[a, b] != 0.0 or bodies.damper[a, b] != 0.0:

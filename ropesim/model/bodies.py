@@ -22,7 +22,9 @@ accelerations (:func:`move_bodies`):
 
 The body's own forces: its weight -m g y at c; buoyancy rho V g y at its centre of buoyancy R c_B; drag on the
 velocity u = U(r) - v of the flow relative to the reference point, F = 1/2 rho R diag(CdA) R^T u |u|, and the
-rotational drag moment -1/2 rho R diag(Cd_r) R^T w |w| (MoorDyn's body drag, ``Body::doRHS``). The added mass
+rotational drag moment -1/2 rho R diag(Cd_r) R^T w |w| (MoorDyn's body drag, ``Body::doRHS``). Under a ``[sea]``
+:mod:`ropesim.model.body_sea` takes the drag's place: the buoyancy lost above the surface, the water's drag on
+the wet part (on the waves' velocity too) and the air's on the dry part, and the water's inertia force. The added mass
 acts on the accelerations alone: the velocity-dependent forces of potential flow on a body (the Munk moment) are
 left out, as MoorDyn leaves them out. The 6 x 6 matrix is symmetric positive definite (a body's own mass or inertia
 may be zero when its attachments carry it); in 2-D the body moves in x, y and turns about z, and the solve keeps
@@ -60,6 +62,7 @@ from collections import namedtuple
 import numpy as np
 
 from . import jit
+from .body_sea import WITH_BODY_SEA, sea_loads
 from .forces.fluid import WITH_FLOW, flow_at, node_tangent
 from ..scene.schema import STILL_KINDS
 from .rotation import cross, matrix_of, quaternion_from_angles, rotate, rotate_back, turn
@@ -68,7 +71,7 @@ WITH_BODIES = jit.Switch("bodies", "free rigid bodies")
 
 Bodies = namedtuple("Bodies", ["mass", "cog", "inertia", "lift", "cob", "drag", "drag_rot", "added", "added_rot",
                                "spring", "damper", "rest", "start", "nodes", "arm", "node_added", "mass0", "factor",
-                               "varies", "rows", "attached_mass", "tangent", "work"])
+                               "varies", "rows", "attached_mass", "tangent", "work", "sea"], defaults=(None,))
 
 POSE, TWIST = 7, 6   # rows of the pose (r, q) and twist (v, w) arrays
 STATE_ROWS = POSE + TWIST   # a saved frame's rows per body
@@ -372,22 +375,26 @@ def own_load(gravity, flow, bodies, pose, twist, b, t, r):
         k0, k1, k2 = cross(bodies.cob[0, b], bodies.cob[1, b], bodies.cob[2, b], l0, l1, l2)
         f0, f1, f2 = f0 + l0, f1 + l1, f2 + l2
         m0, m1, m2 = m0 + k0, m1 + k1, m2 + k2
-    # drag on the flow relative to the reference point, and the rotational drag
-    u0, u1, u2 = -twist[0, b], -twist[1, b], -twist[2, b]
-    if WITH_FLOW:
-        U0, U1, U2 = flow_at(pose[1, b], t, flow[0], flow[1])
-        u0 += U0
-        u1 += U1
-        u2 += U2
-    speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
-    spin = math.sqrt(wb0 * wb0 + wb1 * wb1 + wb2 * wb2)
-    ub0, ub1, ub2 = rotate_back(r, u0, u1, u2)
-    d0, d1, d2 = bodies.drag[0, b] * speed * ub0, bodies.drag[1, b] * speed * ub1, bodies.drag[2, b] * speed * ub2
-    s0 = -bodies.drag_rot[0, b] * spin * wb0
-    s1 = -bodies.drag_rot[1, b] * spin * wb1
-    s2 = -bodies.drag_rot[2, b] * spin * wb2
-    power = d0 * vb0 + d1 * vb1 + d2 * vb2 + s0 * wb0 + s1 * wb1 + s2 * wb2
-    f0, f1, f2, m0, m1, m2 = f0 + d0, f1 + d1, f2 + d2, m0 + s0, m1 + s1, m2 + s2
+    if WITH_BODY_SEA:   # under a free surface: water and air, the lost buoyancy, the water's inertia
+        k0, k1, k2, n0, n1, n2, power = sea_loads(flow, bodies, pose, twist, b, t, r)
+        f0, f1, f2, m0, m1, m2 = f0 + k0, f1 + k1, f2 + k2, m0 + n0, m1 + n1, m2 + n2
+    else:
+        # drag on the flow relative to the reference point, and the rotational drag
+        u0, u1, u2 = -twist[0, b], -twist[1, b], -twist[2, b]
+        if WITH_FLOW:
+            U0, U1, U2 = flow_at(pose[1, b], t, flow[0], flow[1])
+            u0 += U0
+            u1 += U1
+            u2 += U2
+        speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+        spin = math.sqrt(wb0 * wb0 + wb1 * wb1 + wb2 * wb2)
+        ub0, ub1, ub2 = rotate_back(r, u0, u1, u2)
+        d0, d1, d2 = bodies.drag[0, b] * speed * ub0, bodies.drag[1, b] * speed * ub1, bodies.drag[2, b] * speed * ub2
+        s0 = -bodies.drag_rot[0, b] * spin * wb0
+        s1 = -bodies.drag_rot[1, b] * spin * wb1
+        s2 = -bodies.drag_rot[2, b] * spin * wb2
+        power = d0 * vb0 + d1 * vb1 + d2 * vb2 + s0 * wb0 + s1 * wb1 + s2 * wb2
+        f0, f1, f2, m0, m1, m2 = f0 + d0, f1 + d1, f2 + d2, m0 + s0, m1 + s1, m2 + s2
     # the linear spring and damper on the reference point (world axes; no moment about it); the damper's power is
     # the fluid's
     h0, h1, h2 = 0.0, 0.0, 0.0

@@ -21,6 +21,7 @@ import numpy as np
 
 from . import jit
 from .bodies import body_own_system
+from .body_sea import heave_stiffness
 from .forces.gravity import WITH_GRAVITY
 from .rotation import matrix_of, rotate
 
@@ -149,6 +150,7 @@ class StaticBodies:
         self.total, self.own_rhs = np.zeros((self.count, 6)), self.work[:, :, 6].copy()
         self.drag, self.matrix = self.own_rhs.copy(), self.work[:, :, :6].copy()
         self.stiffness = np.zeros((self.count, 3, 3))
+        self.heave = heave_stiffness(self.model, pose, self.t)
         for b in range(self.count):
             members = slice(bundle.start[b], bundle.start[b + 1])
             pulls = on_node[bundle.nodes[members]]
@@ -185,6 +187,7 @@ class StaticBodies:
             block = self.matrix[b].copy()
             block[3:, 3:] += tau * tau * self.stiffness[b]
             block[:3, :3] += tau * tau * np.diag(self.bundle.spring[:, b])
+            block[1, 1] += tau * tau * self.heave[b]   # a floating body's waterplane (model/body_sea.py)
             at = self.offset + b * k
             groups.own[at:at + k, at:at + k] = block[np.ix_(keep, keep)]
             groups.own_rhs[at:at + k] = tau * tau * self.own_rhs[b, keep]

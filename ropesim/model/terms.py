@@ -57,6 +57,7 @@ from .banded import WITH_WRAP_AROUND
 from .forces.fluid import neighbours
 from .junctions import WITH_JUNCTIONS, junction_bundle, move_junctions, no_junctions
 from .bodies import WITH_BODIES, bodies_bundle, body_energy, free_bodies, move_bodies, no_bodies
+from .body_sea import WITH_BODY_SEA, body_sea_bundle
 from .layout import junctions, line_layouts, line_table, point_ends
 from .jacobian import pair_damper_blocks, pair_spring_blocks
 from . import jit
@@ -98,6 +99,8 @@ def model_params(scene, layout: Layout) -> ModelParams:
     points = junction_bundle(groups, added) if groups else no_junctions()
     ends = point_ends(scene, layout.lines)
     bodies = bodies_bundle(scene, ends, added, layout.mass) if free_bodies(scene) else no_bodies()
+    if bodies is not None and scene.sea is not None:   # free bodies under a free surface (model/body_sea.py)
+        bodies = bodies._replace(sea=body_sea_bundle(scene, free_bodies(scene), values[TERMS.index(SEA_TERM)]))
     return ModelParams(1.0 / layout.mass, layout.node_length, line_table(layout.lines), around, points, bodies,
                        *values)
 
@@ -121,6 +124,8 @@ def switches(scene) -> jit.Switches:
         on.add(WITH_JUNCTIONS.name)
     if free_bodies(scene):
         on.add(WITH_BODIES.name)
+        if scene.sea is not None:
+            on.add(WITH_BODY_SEA.name)
     if any(term.velocity for term in declared) or junctions(scene) or free_bodies(scene):
         on.add(WITH_VELOCITY_TERMS.name)   # a junction's or a body's kick solves for its point or body
     if any(term.ledger == "box" for term in declared):

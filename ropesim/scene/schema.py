@@ -273,8 +273,10 @@ class Sea:
     of the line's diameter cut by the surface (a floating line rests at Archimedes' draught); a point body, a
     sphere of its volume. The part in air feels drag with the air's density on its velocity relative to the
     ``wind``, and no buoyancy. A ``[flow]`` is the current in the water. ``[waves]`` move the surface; without
-    them the water is still. Not combined with a sea: ``[drag]`` and ``[viscous_drag]`` (a linear coefficient has
-    no fluid property to carry from water to air), and (yet) free rigid bodies."""
+    them the water is still. A free rigid body is a vertical-walled body of its ``height`` about its centre of
+    buoyancy, cut by the surface above its reference point; it feels the water's velocity and acceleration there.
+    Not combined with a sea: ``[drag]`` and ``[viscous_drag]`` (a linear coefficient has no fluid property to
+    carry from water to air)."""
 
     level: float = spec("float", "height y of the mean water level", "m", default=0.0)
     depth: float | None = spec("float", "water depth the waves feel (default: level - seabed.height; without a "
@@ -288,7 +290,8 @@ class Sea:
                                           "each a horizontal position (2-D: x; 3-D: x and the other horizontal "
                                           "axis)", "m", default=None, required=False)
     fraction: str = spec("str", "a node's submerged part: cylinders (its half segments cut by the surface at "
-                                "the node, exact) or moordyn (MoorDyn 2's rule, for comparing with it)",
+                                "the node, exact) or moordyn (MoorDyn 2's rule, for comparing with it; a free "
+                                "body then stays wholly submerged and feels no water acceleration, as MoorDyn's)",
                          default="cylinders", choices=("cylinders", "moordyn"))
 
 
@@ -533,6 +536,10 @@ class RigidBody:
     volume: float = spec("float", "its displaced volume (buoyancy)", "m^3", default=0.0, low=0)
     center_of_buoyancy: tuple | None = spec("vector", "the centre of its displaced volume, in its frame", "m",
                                             default=None, required=False)
+    height: float | None = spec("float", "free body under a [sea]: the height of its displaced volume, taken as "
+                                         "vertical-walled and centred on the centre of buoyancy (waterplane area "
+                                         "volume / height, heave stiffness rho g volume / height)", "m",
+                                default=None, required=False, low=0, open_low=True)
     cd_area: tuple | None = spec("vector", "drag coefficient times area along each body axis, CdA", "m^2",
                                  default=None, required=False)
     cd_rotation: tuple | None = spec("angles", "rotational drag coefficient about each body axis: moment "

@@ -47,9 +47,7 @@ def resolve_sea(scene: S.Scene, base_dir: Path, fail) -> S.Scene:
     for key, why in NOT_WITH_A_SEA.items():
         if getattr(scene, key) not in (None, ()):
             fail(key, why)
-    if any(body.kind == "free" for body in scene.rigid_bodies):
-        fail("rigid_bodies", "a free rigid body does not yet feel a [sea]'s surface (its buoyancy, drag and "
-                             "inertia assume it submerged); fix or drive it, or leave out [sea]")
+    _check_bodies(scene, fail)
     depth = _depth(scene, fail)
     if sea.probes is not None:
         _check_probes(scene, fail)
@@ -58,6 +56,18 @@ def resolve_sea(scene: S.Scene, base_dir: Path, fail) -> S.Scene:
         _check_breaking(waves, depth, scene.gravity.g, fail)
         scene = replace(scene, waves=waves)
     return scene
+
+
+def _check_bodies(scene: S.Scene, fail) -> None:
+    """A free body under the surface needs the height of its displaced volume (its waterplane area is volume /
+    height), unless ``fraction = "moordyn"`` keeps it wholly submerged, as MoorDyn's body is."""
+    for i, body in enumerate(scene.rigid_bodies):
+        if body.kind != "free" or body.height is not None or scene.sea.fraction == "moordyn":
+            continue
+        fail(f"bodies.{i}.height", f"missing: free body '{body.id}' under a [sea] needs the height of its "
+                                    f"displaced volume [m] (a vertical-walled body centred on its centre of "
+                                    f"buoyancy; waterplane area = volume / height), or [sea] fraction = "
+                                    f"'moordyn' for MoorDyn's always-submerged body")
 
 
 def _depth(scene: S.Scene, fail) -> float:

@@ -210,6 +210,11 @@ def _resolve_body(scene: S.Scene, j: int, body: S.RigidBody, base_dir: Path, fai
         for k in ("stiffness", "damping"):
             if getattr(body, k) is not None:
                 fail(f"{key}.{k}", f"acts on a free body; this body is '{body.kind}' and does not move by its forces")
+    if body.height is not None and body.kind != "free":
+        fail(f"{key}.height", f"is where a [sea]'s surface cuts a free body; this body is '{body.kind}' and feels "
+                              f"no forces of its own")
+    if body.height is not None and scene.sea is None:
+        fail(f"{key}.height", "is where a [sea]'s surface cuts the body: it needs a [sea] (or leave it out)")
     for k in ("stiffness", "damping"):
         if getattr(body, k) is not None and min(getattr(body, k)) < 0:
             fail(f"{key}.{k}", f"must be at least 0 along every axis, got {list(getattr(body, k))}")
