@@ -159,8 +159,7 @@ def compile_all(methods: list[str] | None = None, scenes: list | None = None, st
                 family, shared, count = "statics", "", len(scenes)
             else:
                 method = METHODS[name]
-                runs = [replace(scene, integrator=replace(scene.integrator, method=name)) for scene in scenes
-                        if method.moves_free_bodies or not any(b.kind == "free" for b in scene.rigid_bodies)]
+                runs = [replace(scene, integrator=replace(scene.integrator, method=name)) for scene in scenes]
                 for scene in runs:
                     warm_up(scene)
                 family, count = method.kind, len(runs)

@@ -183,9 +183,11 @@ def _blow_up_message(model: Model, integrator: Integrator, code: int, node: int)
 
 
 # Measured cost of the kernel per node and step [ns] (helicopter_mass at 21 and 201 nodes, the larger of the
-# two; scripts/bench_runfolder.py --costs), and of deriving and writing a saved frame per node [ns].
+# two), and of deriving and writing a saved frame per node [ns]. galpha's (fixed steps) from its ratio to rk4's
+# in one run of scripts/bench_node_step.py (rk4 38 and 49, sdirk2 392 and 390, galpha 85 and 119 ns at 201 and
+# 21 nodes: 2.2 rk4's, 0.22 sdirk2's; scaled by rk4's, the larger of the two scalings).
 NS_PER_NODE_STEP = {"symplectic_euler": 4.2, "verlet": 6.2, "yoshida4": 19.0, "pefrl": 20.0, "rk4": 180.0,
-                    "sdirk2": 1100.0}
+                    "sdirk2": 1100.0, "galpha": 400.0}
 NS_PER_NODE_FRAME = 150.0
 # What a [sea] adds per node and force evaluation [ns]: the surface, fractions and split drag, then each wave
 # component, advanced by a multiplication for a spectrum, evaluated directly for a table or a regular wave

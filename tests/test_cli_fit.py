@@ -51,6 +51,19 @@ def test_check_json_is_one_object_with_the_bounds():
     assert "springs" in data["force_terms"]
 
 
+def test_check_says_that_with_a_tolerance_dt_is_the_reporting_grid():
+    """galpha with integrator.tolerance chooses its own steps: `ropesim check` calls dt the grid x and v are
+    reported on, in its table and in its JSON ("dt_is")."""
+    sets = ("--set", "integrator.method=galpha", "--set", "integrator.tolerance=1e-3")
+    table = invoke("check", "helicopter_mass", *sets)
+    assert table.exit_code == 0, table.output
+    text = " ".join(table.output.split())
+    assert "adaptive steps to a tolerance of 0.001 m; dt = 0.001 s is the reporting grid" in text, text
+    data = json.loads(invoke("check", "helicopter_mass", "--json", *sets).stdout)
+    assert data["dt_is"] == "grid"
+    assert json.loads(invoke("check", "helicopter_mass", "--json").stdout)["dt_is"] == "step"
+
+
 def test_equilibrium_json_has_the_supports_and_tensions(tmp_path):
     result = invoke("equilibrium", "mooring_chain", "--json", "-o", tmp_path / "static.toml")
     assert result.exit_code == 0, result.output

@@ -85,6 +85,7 @@ PROBE = textwrap.dedent("""
     out = {}
     with tempfile.TemporaryDirectory() as tmp:
         cases += [(mooring, [f"integrator.method={m}"]) for m in METHODS if mooring]
+        cases += [(name, ["integrator.method=galpha"]) for name in scenes if name == "spread_mooring_free"]
         for name, sets in cases:
             before = len(compiled)
             args = ["run", name, "--out", f"{tmp}/run", "--quiet", "--force", "--set", "integrator.t_end=0.02"]
@@ -125,8 +126,10 @@ def _compile_then_probe(cache: str, folder: Path, scenes: list[str], mooring: bo
 
 
 def _check_nothing_compiles(runs: dict, scenes: list[str], mooring: bool) -> None:
-    # the runs of the scenes, helicopter_mass and the mooring line with every method, then the static solves
-    assert len(runs) == len(scenes) + (1 + mooring) * len(METHODS) + len(scenes) + mooring
+    # the runs of the scenes, helicopter_mass and the mooring line with every method, galpha on the free spar (a
+    # free rigid body), then the static solves
+    free = "spread_mooring_free" in scenes
+    assert len(runs) == len(scenes) + (1 + mooring) * len(METHODS) + free + len(scenes) + mooring
     for case, (code, compiled, compile_time) in runs.items():
         assert code == 0, case
         assert compiled == [], f"{case} compiled {compiled}"
@@ -143,7 +146,7 @@ def test_ropesim_compile_from_an_empty_cache_compiles_each_family_once(tmp_path)
     for name in [*METHODS, "static solver"]:
         assert any(line.split()[:1] == [name.split()[0]] for line in table.splitlines()), (name, table)
     lines = {line.split()[0]: line for line in table.splitlines() if line.split()[:1]}
-    for name in ("symplectic_euler", "rk4", "sdirk2"):
+    for name in ("symplectic_euler", "rk4", "sdirk2", "galpha"):   # galpha for the free-body scenes too
         assert "compiled" in lines[name], table
     for name in ("verlet", "yoshida4", "pefrl"):
         assert "shares the loop of symplectic_euler" in lines[name], table

@@ -479,10 +479,9 @@ def compile_(
 
     A scene compiles only the parts it uses, the first time it runs (a few seconds, once; then it loads from
     the cache in a fraction of a second). This compiles the loop of every integrator for every built-in scene
-    (or the scenes given; galpha for those without a free rigid body, which it does not move yet), the tension
-    and support forces of a saved frame, and the static solver of `ropesim equilibrium`, then prints what it
-    compiled and how long each took. A scene of your own with parts no built-in scene combines compiles its own
-    copy: name it here to prepare it too. The cache is the folder
+    (or the scenes given), the tension and support forces of a saved frame, and the static solver of
+    `ropesim equilibrium`, then prints what it compiled and how long each took. A scene of your own with parts
+    no built-in scene combines compiles its own copy: name it here to prepare it too. The cache is the folder
     ropesim chose for this installation (or NUMBA_CACHE_DIR): run it as the user who will run ropesim, on the
     same kind of CPU.
     """

@@ -207,8 +207,15 @@ def print_check(scene: Scene, source: Path) -> None:
         parts = [f"mass {o.mass:g} kg" if o.mass is not None else "", f"drag {o.drag:g} kg/s" if o.drag is not None
                  else ""]
         table.add_row(f"node {o.index}", ", ".join(p for p in parts if p))
-    table.add_row("time", f"{scene.integrator.method}, dt = {grid.dt:.6g} s, t_end = {scene.integrator.t_end:g} s "
-                          f"({grid.steps} steps, {grid.frames} frames)")
+    tol = getattr(scene.integrator, "tolerance", None)
+    if tol is None:
+        table.add_row("time", f"{scene.integrator.method}, dt = {grid.dt:.6g} s, t_end = {scene.integrator.t_end:g} "
+                              f"s ({grid.steps} steps, {grid.frames} frames)")
+    else:   # the scheme chooses its own steps; dt is where x and v are reported (dense output)
+        table.add_row("time", f"{scene.integrator.method}, adaptive steps to a tolerance of {tol:g} m; dt = "
+                              f"{grid.dt:.6g} s is the reporting grid (x and v read off the steps by dense output), "
+                              f"t_end = {scene.integrator.t_end:g} s ({grid.steps} grid points, {grid.frames} "
+                              f"frames)")
     for key, value in stability_rows(model, scene.integrator.method, grid.dt):
         table.add_row(key, value)
     _console().print(table)
@@ -613,6 +620,7 @@ def check_data(scene: Scene, source) -> dict:
     out.update({
         "method": scene.integrator.method, "dt_s": grid.dt, "t_end_s": scene.integrator.t_end,
         "steps": grid.steps, "frames": grid.frames,
+        "dt_is": "grid" if getattr(scene.integrator, "tolerance", None) is not None else "step",
         "omega_max_rad_per_s": omega if omega_gershgorin > 0 else None,
         "stable_dt_s": {b.method: (None if b.dt_spectral == float("inf") else b.dt_spectral) for b in rows},
     })

@@ -104,7 +104,6 @@ class Method:
     exact_contact_kicks = False    # the thrower's and guides' damping integrated exactly when their edges are smooth
     unconditionally_stable = False
     starts_from_x_and_v = True     # a step needs x and v alone (generalized-alpha also carries an acceleration)
-    moves_free_bodies = True       # runs a system with free rigid bodies
 
     @property
     def family(self) -> type:

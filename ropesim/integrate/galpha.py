@@ -19,17 +19,22 @@ damping: the same block-banded shape as SDIRK2's M + s^2 K + s C (:mod:`ropesim.
 assembled with s = sqrt(c2): the stiffness is exact, the linear drag is corrected on the diagonal, and the other
 damping's weight is off by the factor gam sqrt((1 - af) / ((1 - am) beta)) (1 at rho_inf = 1, at most 1.06 at
 rho_inf = 0), which slows Newton's convergence by a few per cent and never changes its solution. Each line is
-banded and a system's points are joined by a Schur complement (:mod:`ropesim.model.schur`), as in SDIRK2.
+banded and a system's points and free rigid bodies are joined by a Schur complement (:mod:`ropesim.model.schur`),
+as in SDIRK2; a body's six unknowns (its reference point and a rotation vector on its orientation) are stepped as
+the nodes are (:mod:`ropesim.integrate.galpha_bodies`).
 
 Modified Newton: the matrix is factored when the step size changes by more than REUSE_WITHIN or when Newton
-converges slowly (an update not smaller than RATE_REFACTOR times the one before it), and is otherwise reused,
-across steps too. A full update
-that raises the residual (a contact switching on, a segment going slack) is halved (a backtracking line search).
-The non-smooth terms are not regularised beyond what the force terms already do (the seabed's onset and the
-friction have their own smoothing lengths, see the seabed's docs), with one exception: MoorDyn's two-way seabed
-damping (``damping_both_ways``), a force that jumps by c A |v . n| at first contact, grows in over the seabed's
-delta_d for galpha (:mod:`ropesim.model.forces.seabed`); compressive geometric stiffness is left out of the
-matrix as in SDIRK2.
+converges slowly (an update not smaller than RATE_REFACTOR times the one before it), and is otherwise reused, across
+steps too. A free body's updates are watched on their own (its block goes stale as it turns): with a matrix from an
+earlier step, one above BODY_RATE_REFACTOR times the body's last is not convergence, and factors the matrix again.
+Without that, the stale block's few 1e-15 m of error a step, divided by beta_v into the body's velocities, added up
+over many small steps (the tumbling tripod at 78 us: its angular velocity 1.1e-6 rad/s off after 0.1 s, 6e-8 with
+it, near a fresh matrix every step). A full update that raises the residual (a contact switching on, a segment going
+slack) is halved (a backtracking line search). The non-smooth terms are not regularised beyond what the force terms
+already do (the seabed's onset and the friction have their own smoothing lengths, see the seabed's docs), with one
+exception: MoorDyn's two-way seabed damping (``damping_both_ways``), a force that jumps by c A |v . n| at first
+contact, grows in over the seabed's delta_d for galpha (:mod:`ropesim.model.forces.seabed`); compressive geometric
+stiffness is left out of the matrix as in SDIRK2.
 
 For a stiff line read by its tension (a mooring), rho_inf = 0 is the setting: af = 0, so the force balance is
 solved at the step's end itself and the tension at a step end (EA times its strain) is the solved one; with
@@ -57,6 +62,7 @@ from ..model.banded import factor, solve, woodbury
 from ..model.forces.added_mass import added_mass_times
 from ..model.forces.seabed import WITH_SEABED, depth
 from ..model.jacobian import Jacobian, band_width
+from ..model.bodies import WITH_BODIES, place_attachments
 from ..model.junctions import (WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_junctions,
                                junction_added_mass_residual)
 from ..model.schur import model_groups, schur_factor, schur_solve
@@ -64,10 +70,14 @@ from ..model.terms import (WITH_ADDED_MASS, WITH_APPLIED, accelerations, applied
                            newton_matrix, solve_accelerations)
 from .base import Integrator, Method
 from .health import BOX, DRAG, FLUID, HELD, INTERNAL, NEWTON_FAILED, OK, SEABED, due, end_step, held_power, place, power
+from .galpha_bodies import (body_alpha, dense_output_bodies, error_ratio_bodies, fluid_power_bodies,
+                            keep_step_start_bodies, raw_error_bodies, rotation_stride, rows_bodies,
+                            start_accelerations_bodies, state_names, step_end_bodies, step_start_bodies)
 from .galpha_adaptive import (ACCEPTED, EST_MAX, EST_SUM, H_MAX, H_MIN, H_NEXT, NEWTON_FRACTION, NEWTON_SHRINK,
                               REJECTED, RTOL, SMALLEST, T0, T1, TOL, LIMITING, WITH_ADAPTIVE, dense_output, error_ratio,
                               land, new_adapt, next_step, raw_error)
 from .sdirk import take_back_half, take_update
+from .sdirk_bodies import place_stage, take_back_half_bodies, take_body_update
 
 DEFAULT_RHO_INF = 0.9
 NEWTON_TOL = 1e-9        # on the largest position update, times the shortest segment: a strain of 1e-9 (EA 1e-9,
@@ -80,6 +90,7 @@ RATE_REFACTOR = 0.1      # an update larger than this times the one before it: f
 REUSE_WITHIN = 0.25      # a matrix factored for a step within this fraction of the step is reused
 BACKTRACK_ABOVE = 1e3    # halve an update that raised the residual, unless it was within this many tolerances
 MAX_HALVINGS = 8
+BODY_RATE_REFACTOR = 1e-3   # a free body's update larger than this times its last: factor again (see solve_step)
 
 # the control array: the step the matrix was factored for (0: none), whether a_n holds the start's acceleration,
 # the last step (0: none)
@@ -107,7 +118,6 @@ class GeneralizedAlpha(Method):
     rho_inf: float = DEFAULT_RHO_INF
     unconditionally_stable = True
     starts_from_x_and_v = False
-    moves_free_bodies = False
 
     @property
     def family(self) -> type:
@@ -150,8 +160,9 @@ Work = namedtuple("Work", ["Xk", "Xa", "Vk", "X", "V", "acc", "acc_box", "tmp"])
 """The step's known parts (Xk, Xa, Vk), its unknowns at the force point (X, V), accelerations there and scratch,
 all (D, N)."""
 
-Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol", "step", "groups"])
-"""As SDIRK2's (:class:`ropesim.integrate.sdirk.Newton`), without the bodies."""
+Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol", "step", "groups", "body"])
+"""As SDIRK2's (:class:`ropesim.integrate.sdirk.Newton`), the free bodies' arrays those of
+:class:`ropesim.integrate.galpha_bodies.BodyAlpha`."""
 
 Nodes = namedtuple("Nodes", ["free", "mass", "drag"])
 """Per node: free (not held), mass [kg], linear drag b [kg/s] (0 at held nodes)."""
@@ -162,9 +173,6 @@ class GeneralizedAlphaFamily(Integrator):
     acceleration a_n, the statistics, the control flags and the factored matrix (reused across steps)."""
 
     def __init__(self, model, grid, method: GeneralizedAlpha):
-        if model.body_pose0.shape[1]:
-            raise ValueError("galpha does not move free rigid bodies yet; a system with a free body runs with "
-                             "sdirk2, rk4 or a splitting scheme")
         super().__init__(model, grid, method)
         scene = model.scene
         rho = getattr(scene.integrator, "rho_inf", None)
@@ -175,8 +183,10 @@ class GeneralizedAlphaFamily(Integrator):
         nt, m = dim * n, w * dim
         jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
         tol = NEWTON_TOL * min(line.segment_length for line in model.lines)
-        groups = model_groups(model, w, bodies=False) if WITH_JUNCTIONS.name in model.switches else None
-        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, tol, np.zeros(nt), groups)
+        grouped = {WITH_JUNCTIONS.name, WITH_BODIES.name} & model.switches
+        groups = model_groups(model, w) if grouped else None   # a rope's: none
+        body = body_alpha(model, groups) if WITH_BODIES.name in model.switches else None
+        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, tol, np.zeros(nt), groups, body)
         self.work = Work(*(np.zeros((dim, n)) for _ in Work._fields))
         self.nodes = Nodes(np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag))
         self.acc_n = np.zeros((dim, n))
@@ -193,6 +203,13 @@ class GeneralizedAlphaFamily(Integrator):
         self.STATE = ("acc_n", "stats", "control", "powers", *self.matrix)
         self.adapt = None
         tol = scene.integrator.tolerance
+        if body is not None:   # A_n, and the adaptive steps' last step's ends (from the bodies' starting state)
+            for start, now in ((body.pose0, self.pose), (body.pose1, self.pose), (body.twist0, self.twist),
+                               (body.twist1, self.twist)):
+                start[:] = now
+            for name, array in state_names(body, tol is not None).items():
+                setattr(self, name, array)
+                self.STATE += (name,)
         if tol is not None:   # the scheme's own steps; x, v on the grid by dense output
             rtol = scene.integrator.relative_tolerance or 0.0
             self.adapt = new_adapt(self.x, self.v, self.ledger, grid.dt, tol, rtol)
@@ -240,8 +257,9 @@ class GeneralizedAlphaFamily(Integrator):
 
 
 @jit.kernel
-def start_acceleration(x, v, an, tmp, t, held, nodes, params):
-    """a_n = the accelerations at (x, v) at time t (drag, added mass and points included; zero at held nodes)."""
+def start_acceleration(x, v, an, tmp, t, held, nodes, params, bodies, body):
+    """a_n = the accelerations at (x, v) at time t (drag, added mass, points and free bodies included; zero at held
+    nodes); the free bodies' A_n into ``body``."""
     free, mass, drag = nodes
     dim, n = x.shape
     accelerations(x, v, an, params, t)
@@ -250,6 +268,8 @@ def start_acceleration(x, v, an, tmp, t, held, nodes, params):
             an[d, i] -= drag[i] * v[d, i] / mass[i]
     if WITH_ADDED_MASS or WITH_JUNCTIONS:
         solve_accelerations(x, v, an, params)
+    if WITH_BODIES:
+        start_accelerations_bodies(x, v, an, params, bodies.pose, bodies.twist, body, t)
     for i in range(n):
         if not free[i]:
             for d in range(dim):
@@ -274,10 +294,11 @@ def step_start(x, v, an, work, co, h):
 
 
 @jit.kernel
-def residual(work, rhs, c2, beta_v, t_f, held, nodes, params):
+def residual(work, rhs, c2, beta_v, t_f, held, nodes, params, body, groups):
     """At the force point X, with V = Vk + (X - Xk) / beta_v (held nodes: their own velocity), minus the
     residual M (X - Xa) - c2 (F(X, V) - b V) into ``rhs`` (a point's: the sum of its nodes'). Returns (its
-    squared norm, fluid, internal-damping and seabed power [W])."""
+    squared norm, fluid, internal-damping and seabed power [W]). A free body's line ends sit where its pose at the
+    force point puts them, its residual in its group (:mod:`ropesim.integrate.galpha_bodies`)."""
     Xk, Xa, Vk, X, V, acc = work.Xk, work.Xa, work.Vk, work.X, work.V, work.acc
     free, mass, drag = nodes
     dim, n = X.shape
@@ -287,6 +308,8 @@ def residual(work, rhs, c2, beta_v, t_f, held, nodes, params):
     for j in range(held.idx.shape[0]):
         for d in range(dim):
             V[d, held.idx[j]] = held.v[d, j]
+    if WITH_BODIES:
+        place_stage(body.stage, X, V, beta_v, params.bodies, groups.arm)
     fluid, internal, seabed = accelerations(X, V, acc, params, t_f)
     for i in range(n):
         for d in range(dim):
@@ -308,6 +331,8 @@ def residual(work, rhs, c2, beta_v, t_f, held, nodes, params):
             junction_added_mass_residual(X, Xa, Xa, 0.0, rhs, params.junctions, params.neighbours)
         fold_junctions(rhs, params.junctions, dim)
     norm = 0.0
+    if WITH_BODIES:
+        norm += rows_bodies(body, X, V, acc, c2, beta_v, t_f, nodes, params, groups, rhs)
     for u in range(rhs.shape[0]):
         norm += rhs[u] * rhs[u]
     return norm, fluid, internal, seabed
@@ -361,8 +386,8 @@ def factor_matrix(work, newton, c2, beta_v, t_f, nodes, params):
                 band[0, i * dim + d] += (c2 / beta_v - s) * drag[i]
     if WITH_SEABED:
         friction_slope(X, V, band, c2 / beta_v, free, params.seabed)
-    if WITH_JUNCTIONS:
-        if WITH_ADDED_MASS:
+    if WITH_JUNCTIONS or WITH_BODIES:
+        if WITH_JUNCTIONS and WITH_ADDED_MASS:
             add_junction_added_mass_jacobian(X, band, params.junctions, params.neighbours)
         return schur_factor(band, newton.jac.w, params.lines, newton.groups)
     return factor(band, newton.jac.corner, newton.cyclic, band.shape[0] - 1, newton.wood)
@@ -386,13 +411,18 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats):
     last = np.inf
     stride = 0.0
     previous = 0.0
+    turning = 0.0   # the bodies' last update (their points' largest displacement [m]): its own rate
+    refreshed = False   # the matrix factored in this step
     halvings = 0
     for it in range(NEWTON_MAX_ITER):
-        norm, fluid, internal, seabed = residual(work, rhs, c2, beta_v, t_f, held, nodes, params)
+        norm, fluid, internal, seabed = residual(work, rhs, c2, beta_v, t_f, held, nodes, params, newton.body,
+                                                 newton.groups)
         if norm > last and stride > BACKTRACK_ABOVE * newton.tol and halvings < MAX_HALVINGS:
             halvings += 1   # the update made things worse: go back half of it (and factor afresh there)
             stride *= 0.5
             take_back_half(X, newton.step)
+            if WITH_BODIES:
+                take_back_half_bodies(newton.body.stage)
             refactor = True
             continue
         last = norm
@@ -405,23 +435,33 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats):
             control[FACTORED_H] = h
             stats[FACTORISATIONS] += 1
             refactor = False
-        if WITH_JUNCTIONS:
+            refreshed = True
+        if WITH_JUNCTIONS or WITH_BODIES:
             schur_solve(band, newton.jac.w, params.lines, newton.groups, rhs)
         else:
             solve(band, newton.jac.corner, newton.cyclic, p, rhs, newton.wood)
         previous = stride
         stride, worst_node = take_update(X, rhs, newton.step)
+        slow_body = False
+        if WITH_BODIES:
+            moved = max(take_body_update(newton.body.stage, newton.groups), rotation_stride(newton.body))
+            slow_body = (not refreshed and turning > 0.0 and moved > BODY_RATE_REFACTOR * turning
+                         and moved > newton.tol * 1e-3)
+            turning = moved
+            stride = max(stride, moved)
         stats[ITERATIONS] += 1
         rate = stride / previous if previous > 0.0 else 1.0
-        if stride <= newton.tol or (rate < 1.0 and stride * rate / (1.0 - rate) <= newton.tol):
+        if not slow_body and (stride <= newton.tol or (rate < 1.0 and stride * rate / (1.0 - rate) <= newton.tol)):
             for d in range(X.shape[0]):
                 for i in range(X.shape[1]):
                     V[d, i] = work.Vk[d, i] + (X[d, i] - work.Xk[d, i]) / beta_v
             for j in range(held.idx.shape[0]):
                 for d in range(X.shape[0]):
                     V[d, held.idx[j]] = held.v[d, j]
+            if WITH_BODIES:
+                place_stage(newton.body.stage, X, V, beta_v, params.bodies, newton.groups.arm)
             return it + 1, -1, fluid, internal, seabed
-        if it > 0 and not fresh and rate > RATE_REFACTOR:
+        if it > 0 and not fresh and (rate > RATE_REFACTOR or slow_body):
             refactor = True   # the old matrix converges slowly here: factor it at this iterate
     control[FACTORED_H] = 0.0
     return -1, worst_node, 0.0, 0.0, 0.0
@@ -489,7 +529,7 @@ def advance_galpha(state, work, newton, co, held, nodes, params, limits, schedul
     h = schedule.h
     frame = np.int64(0)   # not the literal 0: Numba would compile the frame saving twice (for 0, then int64)
     if control[STARTED] == 0.0:
-        start_acceleration(x, v, an, work.tmp, schedule.step0 * h, held, nodes, params)
+        start_acceleration(x, v, an, work.tmp, schedule.step0 * h, held, nodes, params, bodies, newton.body)
         stats[ITERATIONS] += 1
         control[STARTED] = 1.0
     if WITH_ADAPTIVE:
@@ -499,11 +539,18 @@ def advance_galpha(state, work, newton, co, held, nodes, params, limits, schedul
         step = schedule.step0 + s
         t = step * h
         step_start(x, v, an, work, co, h)
+        if WITH_BODIES:
+            step_start_bodies(newton.body, bodies.pose, bodies.twist, co, h)
         its, node, fluid, internal, seabed = solve_step(work, newton, co, t, h, held, nodes, params, control, stats)
         if its < 0:
             return s, frame, NEWTON_FAILED, node
+        if WITH_BODIES:
+            fluid += fluid_power_bodies(work, params, newton.body, t + (1.0 - co[1]) * h)
         book(ledger, powers, control, co, h, work, fluid, internal, seabed, held, nodes, params)
         step_end(x, v, an, work, co, h, nodes.free)
+        if WITH_BODIES:
+            step_end_bodies(newton.body, bodies.pose, bodies.twist, co, h)
+            place_attachments(x, v, params.bodies, bodies.pose, bodies.twist)
         stats[STEPS] += 1
         place(x, v, held, (step + 1) * h, (step + 1) * h)
         done = step + 1
@@ -517,18 +564,26 @@ def advance_galpha(state, work, newton, co, held, nodes, params, limits, schedul
 
 
 @jit.kernel(inline="always")
-def filtered_error_ratio(work, an, co, h, x, newton, nodes, params, clock, share):
+def filtered_error_ratio(work, an, co, h, t_f, x, newton, nodes, params, clock, share):
     """The step's error estimate filtered by the factored Newton matrix, J^-1 M e (see
     :mod:`ropesim.integrate.galpha_adaptive`), over its allowance; returns (ratio, the largest error [m], its
     node)."""
     band, rhs = newton.jac.band, newton.rhs
     raw_error(work, an, co, h, nodes, rhs)
-    if WITH_JUNCTIONS:
-        fold_junctions(rhs, params.junctions, x.shape[0])
+    if WITH_JUNCTIONS or WITH_BODIES:
+        if WITH_JUNCTIONS:
+            fold_junctions(rhs, params.junctions, x.shape[0])
+        if WITH_BODIES:
+            raw_error_bodies(newton.body, work.X, work.acc, co, h, t_f, params, newton.groups, rhs)
         schur_solve(band, newton.jac.w, params.lines, newton.groups, rhs)
     else:
         solve(band, newton.jac.corner, newton.cyclic, band.shape[0] - 1, rhs, newton.wood)
-    return error_ratio(rhs, x, work.X, co[1], clock[TOL], clock[RTOL], nodes.free, share)
+    ratio, error, node = error_ratio(rhs, x, work.X, co[1], clock[TOL], clock[RTOL], nodes.free, share)
+    if WITH_BODIES:
+        body_ratio, body_error = error_ratio_bodies(newton.body, newton.groups, co[1], clock[TOL], clock[RTOL], share)
+        if body_ratio > ratio:
+            return body_ratio, body_error, -1
+    return ratio, error, node
 
 
 @jit.kernel
@@ -553,6 +608,8 @@ def advance_adaptive(state, work, newton, co, held, nodes, params, limits, sched
                 if h < SMALLEST * t_end:
                     return s, frame, NEWTON_FAILED, -1
                 step_start(x1, v1, an, work, co, h)
+                if WITH_BODIES:
+                    step_start_bodies(newton.body, newton.body.pose1, newton.body.twist1, co, h)
                 its, node, fluid, internal, seabed = solve_step(work, newton, co, t, h, held, nodes, params,
                                                                 control, stats)
                 if its < 0:
@@ -560,7 +617,8 @@ def advance_adaptive(state, work, newton, co, held, nodes, params, limits, sched
                     h *= NEWTON_SHRINK
                     cut = False
                     continue
-                ratio, error, limiting = filtered_error_ratio(work, an, co, h, x1, newton, nodes, params, clock, h / t_end)
+                ratio, error, limiting = filtered_error_ratio(work, an, co, h, t + (1.0 - co[1]) * h, x1, newton,
+                                                              nodes, params, clock, h / t_end)
                 if ratio > 1.0:
                     counts[REJECTED] += 1
                     h = next_step(h, ratio)
@@ -573,8 +631,14 @@ def advance_adaptive(state, work, newton, co, held, nodes, params, limits, sched
                     adapt.v0[d, i] = v1[d, i]
             for k in range(ledger.shape[0]):
                 adapt.ledger0[k] = adapt.ledger1[k]
+            if WITH_BODIES:
+                fluid += fluid_power_bodies(work, params, newton.body, t + (1.0 - co[1]) * h)
             book(adapt.ledger1, powers, control, co, h, work, fluid, internal, seabed, held, nodes, params)
             step_end(x1, v1, an, work, co, h, free)
+            if WITH_BODIES:
+                keep_step_start_bodies(newton.body)
+                step_end_bodies(newton.body, newton.body.pose1, newton.body.twist1, co, h)
+                place_attachments(x1, v1, params.bodies, newton.body.pose1, newton.body.twist1)
             place(x1, v1, held, t + h, t + h)
             stats[STEPS] += 1
             counts[ACCEPTED] += 1
@@ -589,6 +653,9 @@ def advance_adaptive(state, work, newton, co, held, nodes, params, limits, sched
                 clock[H_NEXT] = planned if cut else next_step(h, ratio)   # a step cut to land on a frame neither
                 # grows nor shrinks the next
         dense_output(adapt, target, x, v, ledger)
+        if WITH_BODIES:
+            dense_output_bodies(newton.body, clock[T0], clock[T1], target, bodies.pose, bodies.twist)
+            place_attachments(x, v, params.bodies, bodies.pose, bodies.twist)
         place(x, v, held, target, target)
         if not due(done, schedule):
             continue

@@ -190,7 +190,7 @@ def stage_residual(stage, rhs, beta, t_stage, held, nodes, params, body, groups)
         fold_junctions(rhs, params.junctions, dim)
     norm = 0.0
     if WITH_BODIES:
-        norm += stage_rows(body, X, acc, beta, t_stage, params, groups, rhs)
+        norm += stage_rows(body, X, acc, beta, beta, t_stage, params, groups, rhs)
     for u in range(rhs.shape[0]):
         norm += rhs[u] * rhs[u]
     return norm, fluid, internal, seabed

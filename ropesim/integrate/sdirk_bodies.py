@@ -179,10 +179,12 @@ def _add_drag_rate(own, row, r, d0, d1, d2, u0, u1, u2, scale):
 
 
 @jit.kernel
-def stage_rows(body, X, acc, beta, t, p, groups, rhs):
-    """Every body's stage residual R_b into the groups' ``own_rhs`` and its own block O into ``own`` (see the
-    module doc), from ``acc`` holding every node's F / m at the stage; its attachments' rows of ``rhs`` zeroed.
-    Returns the squared norm of the bodies' residuals."""
+def stage_rows(body, X, acc, beta, damp, t, p, groups, rhs):
+    """Every body's stage residual R_b = -beta [M (W - W_hat) - damp F] into the groups' ``own_rhs`` and its own
+    block O (the module doc's, with beta^2 -> beta damp on the stiffness and beta -> damp on the damping) into
+    ``own``, from ``acc`` holding every node's F / m at the stage; its attachments' rows of ``rhs`` zeroed.
+    SDIRK2 passes damp = beta; generalized-alpha its own pair (:mod:`ropesim.integrate.galpha_bodies`). Returns
+    the squared norm of the bodies' residuals."""
     dim = X.shape[0]
     bodies = p.bodies
     g = p.gravity[0] if WITH_GRAVITY else 0.0
@@ -201,20 +203,20 @@ def stage_rows(body, X, acc, beta, t, p, groups, rhs):
             for j in range(6):
                 s += work[i, j] * (twist[j, b] - body.hat_w[j, b])
                 own[i, j] = work[i, j]
-            work[i, 6] = -beta * (s - beta * work[i, 6])
+            work[i, 6] = -beta * (s - damp * work[i, 6])
         # the plain attachment masses the band holds; the turning forces; the centripetal and drag rates
         m = bodies.mass[b]
         c0, c1, c2 = r[0] * bodies.cog[0, b] + r[1] * bodies.cog[1, b] + r[2] * bodies.cog[2, b], \
             r[3] * bodies.cog[0, b] + r[4] * bodies.cog[1, b] + r[5] * bodies.cog[2, b], \
             r[6] * bodies.cog[0, b] + r[7] * bodies.cog[1, b] + r[8] * bodies.cog[2, b]
-        _add_turning_force(own, 0.0, -m * g, 0.0, c0, c1, c2, beta * beta)
-        _add_centripetal(own, m, 0.0, 0.0, m, 0.0, m, c0, c1, c2, w0, w1, w2, beta)
+        _add_turning_force(own, 0.0, -m * g, 0.0, c0, c1, c2, beta * damp)
+        _add_centripetal(own, m, 0.0, 0.0, m, 0.0, m, c0, c1, c2, w0, w1, w2, damp)
         lift = bodies.lift[b]
         if lift != 0.0:
             k0 = r[0] * bodies.cob[0, b] + r[1] * bodies.cob[1, b] + r[2] * bodies.cob[2, b]
             k1 = r[3] * bodies.cob[0, b] + r[4] * bodies.cob[1, b] + r[5] * bodies.cob[2, b]
             k2 = r[6] * bodies.cob[0, b] + r[7] * bodies.cob[1, b] + r[8] * bodies.cob[2, b]
-            _add_turning_force(own, 0.0, lift, 0.0, k0, k1, k2, beta * beta)
+            _add_turning_force(own, 0.0, lift, 0.0, k0, k1, k2, beta * damp)
         for c in range(bodies.start[b], bodies.start[b + 1]):
             i = bodies.nodes[c]
             mi = 1.0 / p.inv_mass[i]
@@ -223,13 +225,13 @@ def stage_rows(body, X, acc, beta, t, p, groups, rhs):
             p2 = groups.arm[2, body.where[0] + c]
             _add_mass_at(own, -mi, 0.0, 0.0, -mi, 0.0, -mi, p0, p1, p2)
             a2 = acc[2, i] if dim == 3 else 0.0
-            _add_turning_force(own, mi * acc[0, i], mi * acc[1, i], mi * a2, p0, p1, p2, beta * beta)
+            _add_turning_force(own, mi * acc[0, i], mi * acc[1, i], mi * a2, p0, p1, p2, beta * damp)
             a_n, a_t = bodies.node_added[0, c], bodies.node_added[1, c]
             q0, q1, q2 = node_tangent(X, i, p.neighbours)
             extra = a_t - a_n
             _add_centripetal(own, mi + a_n + extra * q0 * q0, extra * q0 * q1, extra * q0 * q2,
                              mi + a_n + extra * q1 * q1, extra * q1 * q2, mi + a_n + extra * q2 * q2,
-                             p0, p1, p2, w0, w1, w2, beta)
+                             p0, p1, p2, w0, w1, w2, damp)
         # the gyroscopic moment: [w]x I - [I w]x, I = R I_b R^T
         for i in range(3):
             for j in range(3):
@@ -243,28 +245,28 @@ def stage_rows(body, X, acc, beta, t, p, groups, rhs):
         i2 = inertia[2, 0] * w0 + inertia[2, 1] * w1 + inertia[2, 2] * w2
         for j in range(3):
             e0, e1, e2 = cross(w0, w1, w2, inertia[0, j], inertia[1, j], inertia[2, j])
-            own[3, 3 + j] += beta * e0
-            own[4, 3 + j] += beta * e1
-            own[5, 3 + j] += beta * e2
-        own[3, 4] += beta * i2     # - [I w]x
-        own[3, 5] -= beta * i1
-        own[4, 3] -= beta * i2
-        own[4, 5] += beta * i0
-        own[5, 3] += beta * i1
-        own[5, 4] -= beta * i0
+            own[3, 3 + j] += damp * e0
+            own[4, 3 + j] += damp * e1
+            own[5, 3 + j] += damp * e2
+        own[3, 4] += damp * i2     # - [I w]x
+        own[3, 5] -= damp * i1
+        own[4, 3] -= damp * i2
+        own[4, 5] += damp * i0
+        own[5, 3] += damp * i1
+        own[5, 4] -= damp * i0
         # drag on the flow relative to the reference point, and the rotational drag
         if WITH_BODY_SEA:   # under a sea: the water's share and the air's, and the waterplane's heave stiffness
             heave, wet, dry, u0, u1, u2, air0, air1, air2 = sea_rates(p.flow, bodies, pose, twist, b, t, r)
-            own[1, 1] += beta * beta * heave
+            own[1, 1] += beta * damp * heave
             ub = rotate_back(r, u0, u1, u2)
             _add_drag_rate(own, 0, r, bodies.drag[0, b], bodies.drag[1, b], bodies.drag[2, b], ub[0], ub[1], ub[2],
-                           beta * wet)
+                           damp * wet)
             ub = rotate_back(r, air0, air1, air2)
             _add_drag_rate(own, 0, r, bodies.drag[0, b], bodies.drag[1, b], bodies.drag[2, b], ub[0], ub[1], ub[2],
-                           beta * dry)
+                           damp * dry)
             wb = rotate_back(r, w0, w1, w2)
             _add_drag_rate(own, 3, r, bodies.drag_rot[0, b], bodies.drag_rot[1, b], bodies.drag_rot[2, b], wb[0],
-                           wb[1], wb[2], beta * (wet + dry))
+                           wb[1], wb[2], damp * (wet + dry))
         else:
             u0, u1, u2 = -twist[0, b], -twist[1, b], -twist[2, b]
             if WITH_FLOW:
@@ -274,14 +276,14 @@ def stage_rows(body, X, acc, beta, t, p, groups, rhs):
                 u2 += U2
             ub = rotate_back(r, u0, u1, u2)
             _add_drag_rate(own, 0, r, bodies.drag[0, b], bodies.drag[1, b], bodies.drag[2, b], ub[0], ub[1], ub[2],
-                           beta)
+                           damp)
             wb = rotate_back(r, w0, w1, w2)
             _add_drag_rate(own, 3, r, bodies.drag_rot[0, b], bodies.drag_rot[1, b], bodies.drag_rot[2, b], wb[0],
-                           wb[1], wb[2], beta)
+                           wb[1], wb[2], damp)
         # the linear spring and damper on the reference point: beta^2 k + beta c on its translation
         for a in range(3):
             if bodies.spring[a, b] != 0.0 or bodies.damper[a, b] != 0.0:
-                own[a, a] += beta * beta * bodies.spring[a, b] + beta * bodies.damper[a, b]
+                own[a, a] += beta * damp * bodies.spring[a, b] + damp * bodies.damper[a, b]
         at = first + b * k
         for a in range(k):
             groups.own_rhs[at + a] = work[keep[a], 6]

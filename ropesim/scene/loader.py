@@ -335,9 +335,6 @@ def _check_system(scene: S.Scene, source: str, base_dir: Path) -> S.Scene:
 
     _check_name_and_length(scene, fail)
     _check_integrator(scene, fail)
-    if scene.integrator.method == "galpha" and any(b.kind == "free" for b in scene.rigid_bodies):
-        fail("integrator.method", "galpha does not move free rigid bodies yet; a system with a free body runs "
-                                  "with sdirk2, rk4 or a splitting scheme")
     scene = resolve_system(scene, base_dir, fail)
     _check_fluid(scene, fail)
     _check_flow_covers_the_start(scene, fail)
