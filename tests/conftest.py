@@ -29,3 +29,16 @@ SCENARIOS = ROOT / "scenarios"
 @pytest.fixture
 def scenarios() -> Path:
     return SCENARIOS
+
+
+def pytest_addoption(parser):
+    parser.addoption("--compile-profile", metavar="DIR", default=None,
+                     help="write each test's CPU, Numba compiles and specialised kernels asked for to DIR "
+                          "(tests/compile_profile; scripts/suite_profile.py prints the table)")
+
+
+def pytest_configure(config):
+    if config.getoption("compile_profile"):
+        import compile_profile
+
+        compile_profile.configure(config)
