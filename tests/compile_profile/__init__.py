@@ -6,8 +6,9 @@ line to ``DIR/tests-<worker>.jsonl``:
 - ``cpu``: the test's CPU seconds in the pytest process (user+sys, set-up and tear-down included);
 - ``children``: CPU seconds of the subprocesses it ran and waited for (the CLI tests, scripts, mkdocs);
 - ``compiles``: every function Numba compiled for it, in this process or in a subprocess, as
-  ``[module.qualname, CPU seconds]`` (a specialised copy's name carries its switch values, ``__s1a``); the
-  seconds of a compile that compiles its callees include theirs, ``compile_cpu`` counts the outermost only;
+  ``[module.qualname, CPU seconds, depth]`` (a specialised copy's name carries its switch values, ``__s1a``);
+  a compile that compiles its callees (depth 1 and more) includes their seconds: ``compile_cpu`` counts the
+  outermost only;
 - ``asked``: the specialised copies (:func:`ropesim.model.jit.specialise`) the test asked for, compiled or
   not: what it *needs*, so that ``scripts/suite_profile.py`` can tell the kernels only one test needs.
 
@@ -24,6 +25,8 @@ import os
 import resource
 import time
 from pathlib import Path
+
+import pytest
 
 HERE = Path(__file__).resolve().parent
 
@@ -103,19 +106,18 @@ class Profile:
         os.environ["ROPESIM_PROFILE_DIR"] = str(self.child_dir)
         os.environ["PYTHONPATH"] = os.pathsep.join([str(HERE), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)
 
+    @pytest.hookimpl(hookwrapper=True)
     def pytest_runtest_protocol(self, item, nextitem):
         os.environ["ROPESIM_PROFILE_TEST"] = item.nodeid
         self.log.take()
         self.asked.clear()
-        self._start = (_own_cpu(), _children_cpu(), time.perf_counter())
-
-    def pytest_runtest_logfinish(self, nodeid, location):
-        own, children, wall = self._start
+        own, children, wall = _own_cpu(), _children_cpu(), time.perf_counter()
+        yield
         events = self.log.take()
-        record = {"test": nodeid, "cpu": _own_cpu() - own, "children": _children_cpu() - children,
+        record = {"test": item.nodeid, "cpu": _own_cpu() - own, "children": _children_cpu() - children,
                   "wall": time.perf_counter() - wall,
                   "compile_cpu": sum(seconds for _, seconds, depth in events if depth == 0),
-                  "compiles": [[name, seconds] for name, seconds, _ in events], "asked": sorted(self.asked)}
+                  "compiles": events, "asked": sorted(self.asked)}
         self.out.write(json.dumps(record) + "\n")
         self.out.flush()
 
