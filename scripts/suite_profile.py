@@ -64,6 +64,20 @@ def own_compiles(tests: dict[str, dict]) -> dict[str, list]:
 
 
 
+def file_own_compiles(tests: dict[str, dict]) -> dict[str, float]:
+    """Per file: seconds compiling the copies that only its tests ask for (moving the file, or the tests of it
+    that ask for them, saves these)."""
+    files_asking: dict[str, set] = defaultdict(set)
+    for nodeid, test in tests.items():
+        for name in test["asked"]:
+            files_asking[name].add(nodeid.split("::")[0])
+    out: dict[str, float] = defaultdict(float)
+    for nodeid, test in tests.items():
+        rows = [row for row in test["compiles"] if files_asking.get(row[0]) == {nodeid.split("::")[0]}]
+        out[nodeid.split("::")[0]] += outermost(rows)
+    return out
+
+
 def outermost(rows: list) -> float:
     """The seconds of ``rows`` (compiles) counted once: a callee compiled inside its caller (depth 1 and more)
     is in its caller's seconds. (A copy only one test needs is called only by copies only that test needs.)"""
@@ -82,6 +96,7 @@ def table(tests: dict[str, dict], top: int) -> str:
               f"{children:.0f} s in their subprocesses ({child_compile:.0f} s compiling); {events} compile events; "
               f"{own_total:.0f} s compiling copies only one test needs", ""]
     header = f"{'CPU s':>7} {'compile':>7} {'subproc':>7} {'compiles':>8} {'own s':>6}  "
+    file_own = file_own_compiles(tests)
 
     files: dict[str, list[float]] = defaultdict(lambda: [0.0, 0.0, 0.0, 0, 0.0])
     for nodeid, t in tests.items():
@@ -91,9 +106,10 @@ def table(tests: dict[str, dict], top: int) -> str:
         row[2] += t["children"]
         row[3] += len(t["compiles"])
         row[4] += outermost(own[nodeid])
-    lines += ["per file (CPU: pytest worker; compile: worker and subprocesses)", header + "file"]
+    lines += ["per file (CPU: pytest worker; compile: worker and subprocesses; own s: copies only one of its tests "
+              "needs; file's: copies only its tests need)", header + f"{'file s':>6}  file"]
     for name, (c, comp, ch, n, o) in sorted(files.items(), key=lambda kv: -(kv[1][0] + kv[1][2])):
-        lines.append(f"{c:7.1f} {comp:7.1f} {ch:7.1f} {n:8d} {o:6.1f}  {name}")
+        lines.append(f"{c:7.1f} {comp:7.1f} {ch:7.1f} {n:8d} {o:6.1f} {file_own[name]:6.1f}  {name}")
 
     lines += ["", f"the {top} costliest tests (worker + subprocesses)", header + "test"]
     ranked = sorted(tests.items(), key=lambda kv: -(kv[1]["cpu"] + kv[1]["children"]))[:top]
