@@ -6,7 +6,8 @@ one test needs.
 
 The first command (tests/compile_profile, an option of tests/conftest.py) writes one line per test; add
 ``ROPESIM_TEST_FRESH_CACHE=1`` to start from an empty compile cache, as CI does, or leave it out to see what a
-second run on unchanged sources costs. This script prints:
+second run on unchanged sources costs (give each run a new folder: records are appended). This script
+prints:
 
 - the totals: CPU seconds in the pytest workers and in the subprocesses the tests ran, and how much of it
   Numba spent compiling (outermost compiles only: a loop's compile includes its callees');

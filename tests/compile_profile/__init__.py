@@ -94,7 +94,6 @@ class Profile:
     """The pytest plugin: one JSON line per test."""
 
     def __init__(self, folder: Path):
-        self.folder = folder
         folder.mkdir(parents=True, exist_ok=True)
         worker = os.environ.get("PYTEST_XDIST_WORKER", "main")
         self.out = open(folder / f"tests-{worker}.jsonl", "a", encoding="utf-8")
