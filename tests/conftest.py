@@ -5,7 +5,8 @@ fingerprint of every source file, so any edit starts an empty one and a stale ke
 never a ``NUMBA_CACHE_DIR`` the environment points at, which may hold kernels of other sources. So a second
 run of the suite on unchanged sources loads what the first compiled, and pytest-xdist's workers share one
 cache. ``ROPESIM_TEST_FRESH_CACHE=1`` starts from an empty folder instead (what a fresh checkout pays, as CI
-does).
+does); with ``ROPESIM_TEST_CACHE=DIR`` beside it, from DIR as an earlier such run left it (the slow suite on
+what the fast one compiled, say).
 """
 
 import os
@@ -13,7 +14,8 @@ import tempfile
 from pathlib import Path
 
 os.environ.pop("NUMBA_CACHE_DIR", None)
-if os.environ.get("ROPESIM_TEST_FRESH_CACHE") and not os.environ.get("PYTEST_XDIST_WORKER"):
+if (os.environ.get("ROPESIM_TEST_FRESH_CACHE") and not os.environ.get("PYTEST_XDIST_WORKER")
+        and not os.environ.get("ROPESIM_TEST_CACHE")):
     os.environ["ROPESIM_TEST_CACHE"] = tempfile.mkdtemp(prefix="ropesim-numba-")   # the workers inherit it
 if os.environ.get("ROPESIM_TEST_FRESH_CACHE"):
     os.environ["NUMBA_CACHE_DIR"] = os.environ["ROPESIM_TEST_CACHE"]
@@ -29,3 +31,16 @@ SCENARIOS = ROOT / "scenarios"
 @pytest.fixture
 def scenarios() -> Path:
     return SCENARIOS
+
+
+def pytest_addoption(parser):
+    parser.addoption("--compile-profile", metavar="DIR", default=None,
+                     help="write each test's CPU, Numba compiles and specialised kernels asked for to DIR "
+                          "(tests/compile_profile; scripts/suite_profile.py prints the table)")
+
+
+def pytest_configure(config):
+    if config.getoption("compile_profile"):
+        import compile_profile
+
+        compile_profile.configure(config)

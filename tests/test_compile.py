@@ -4,8 +4,12 @@ Whether a run compiled is observed, not inferred from its timing: Numba broadcas
 whenever a function compiles (a cache miss) and none when it loads one from its cache, and the probe below
 counts them while it runs every built-in scene, every method on helicopter_mass and on a mooring line of the
 user's that starts in its static shape (named to `ropesim compile`, since a scene compiles only its own parts),
-and the static solver of `ropesim equilibrium` on each, through the command line, from an empty cache (the
-slow suite: it compiles every built-in scene's parts).
+and the static solver of `ropesim equilibrium` on each, through the command line.
+
+Two tests share the work. On the test run's own cache (one per run, tests/conftest.py), which the other tests
+have partly filled, `ropesim compile` prepares every built-in scene and the mooring line and the probe finds
+nothing left to compile (the slow suite: it compiles what no other test needs). On an empty cache, for
+helicopter_mass alone, it compiles each family's loop once: the symplectic family's other methods share it.
 """
 
 from __future__ import annotations
@@ -105,12 +109,14 @@ PROBE = textwrap.dedent("""
 """)
 
 
-def _run(args: list[str], cache: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, *args], capture_output=True, text=True, cwd=ROOT, timeout=900,
-                          env={**os.environ, "NUMBA_CACHE_DIR": cache})
+def _run(args: list[str], cache: str | None) -> subprocess.CompletedProcess:
+    """``python ARGS`` with Numba's cache at ``cache`` (None: the test run's cache, which the environment names)."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": cache} if cache else dict(os.environ)
+    assert env.get("NUMBA_CACHE_DIR")   # set by ropesim's import in this process, or by tests/conftest.py
+    return subprocess.run([sys.executable, *args], capture_output=True, text=True, cwd=ROOT, timeout=900, env=env)
 
 
-def _compile_then_probe(cache: str, folder: Path, scenes: list[str], mooring: bool) -> tuple[str, dict]:
+def _compile_then_probe(cache: str | None, folder: Path, scenes: list[str], mooring: bool) -> tuple[str, dict]:
     """`ropesim compile SCENES` (every built-in scene if none; its table), then, with ``mooring``, `ropesim compile`
     of the mooring scene written in ``folder``, then the probe's runs of them all."""
     path = folder / "mooring.toml"
@@ -139,19 +145,35 @@ def _check_nothing_compiles(runs: dict, scenes: list[str], mooring: bool) -> Non
         assert compile_time < 1.0, case
 
 
-@pytest.mark.slow
-def test_ropesim_compile_from_an_empty_cache_compiles_each_family_once(tmp_path):
-    """Every built-in scene, and a user's mooring line named to `ropesim compile`, from an empty cache."""
-    table, runs = _compile_then_probe(str(tmp_path / "cache"), tmp_path, [], mooring=True)
+def _rows(table: str) -> dict[str, str]:
+    """The table's rows by their first word (a method's name, "static" for the static solver)."""
     for name in [*METHODS, "static solver"]:
         assert any(line.split()[:1] == [name.split()[0]] for line in table.splitlines()), (name, table)
-    lines = {line.split()[0]: line for line in table.splitlines() if line.split()[:1]}
-    for name in ("symplectic_euler", "rk4", "sdirk2", "galpha"):   # galpha for the free-body scenes too
+    return {line.split()[0]: line for line in table.splitlines() if line.split()[:1]}
+
+
+@pytest.mark.slow
+def test_ropesim_compile_prepares_every_built_in_scene_so_that_no_run_compiles(tmp_path):
+    """Every built-in scene, and a user's mooring line named to `ropesim compile`, on the test run's cache: what
+    the other tests compiled is loaded, the rest compiled, and then nothing compiles."""
+    table, runs = _compile_then_probe(None, tmp_path, [], mooring=True)
+    _rows(table)
+    assert f"made ready for {len(builtin_names())} built-in scenes:" in " ".join(table.split())
+    _check_nothing_compiles(runs, builtin_names(), mooring=True)
+
+
+@pytest.mark.slow
+def test_ropesim_compile_from_an_empty_cache_compiles_each_family_once(tmp_path):
+    """helicopter_mass from an empty cache: one loop per family, shared by the family's methods, after which none
+    of its runs (every method) nor its static solve compiles."""
+    table, runs = _compile_then_probe(str(tmp_path / "cache"), tmp_path, ["helicopter_mass"], mooring=False)
+    lines = _rows(table)
+    for name in ("symplectic_euler", "rk4", "sdirk2", "galpha", "static"):
         assert "compiled" in lines[name], table
     for name in ("verlet", "yoshida4", "pefrl"):
         assert "shares the loop of symplectic_euler" in lines[name], table
-    assert f"made ready for {len(builtin_names())} built-in scenes:" in table
-    _check_nothing_compiles(runs, builtin_names(), mooring=True)
+    assert "made ready for 1 scene:" in " ".join(table.split())
+    _check_nothing_compiles(runs, ["helicopter_mass"], mooring=False)
 
 
 @pytest.mark.parametrize("args, message", [

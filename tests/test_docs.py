@@ -271,6 +271,10 @@ def test_cli_reference_places_new_commands(monkeypatch):
 
 # -------------------------------------------------------------------------------------------- the built site
 
+# Building the site executes the notebooks and renders every page in Chromium: a minute or more of CPU, in the
+# slow suite (which CI runs, so CI still builds the site once); the quick loop checks the pages' sources above.
+BUILT_SITE = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def site(tmp_path_factory) -> Path:
@@ -298,6 +302,7 @@ def _html_rows(section: str) -> list[str]:
     return [html.unescape(re.sub(r"<[^>]+>", " ", row)) for row in re.findall(r"<tr>(.*?)</tr>", section, re.S)]
 
 
+@BUILT_SITE
 def test_built_scene_reference_has_every_key_with_its_unit(site):
     sections = _html_sections(site / "reference" / "scene" / "index.html")
     for name, keys in schema_sections().items():
@@ -309,6 +314,7 @@ def test_built_scene_reference_has_every_key_with_its_unit(site):
                 f"built scene reference #{name}: no row for {key} with unit {unit!r}"
 
 
+@BUILT_SITE
 def test_built_cli_reference_has_every_option(site):
     sections = _html_sections(site / "reference" / "cli" / "index.html")
     for command, spellings in cli_options().items():
@@ -319,6 +325,7 @@ def test_built_cli_reference_has_every_option(site):
                 f"built CLI reference, ropesim {command}: {spelling} missing"
 
 
+@BUILT_SITE
 def test_built_api_page_documents_every_public_name(site):
     import ropesim
 
@@ -327,6 +334,7 @@ def test_built_api_page_documents_every_public_name(site):
         assert re.search(rf'<h2 id="[^"]*\.{name}"', text), f"API page: no entry for ropesim.{name}"
 
 
+@BUILT_SITE
 def test_built_site_has_every_page_and_image(site):
     for page in DOCS.rglob("*.md"):
         if "notebooks" in page.parts:
@@ -339,6 +347,7 @@ def test_built_site_has_every_page_and_image(site):
         assert (site / image.relative_to(DOCS)).is_file()
 
 
+@BUILT_SITE
 def test_the_notebooks_are_pages_with_their_outputs(site):
     """mkdocs-jupyter executed docs/notebooks/*.ipynb at the build: their pages show what the cells printed and
     drew (the stored notebooks have no outputs; tests/test_notebook.py runs them too)."""
@@ -487,6 +496,7 @@ def _each_page(rendered: dict, check) -> dict[str, list[str]]:
     return {page: problems for page, problems in found.items() if problems}
 
 
+@BUILT_SITE
 def test_code_blocks_fit_the_column_at_1280_px(rendered):
     """No code block scrolls sideways on a 1280-px screen: commands and outputs are reflowed to the column."""
     assert _each_page(rendered, wide_blocks) == {}
@@ -494,6 +504,7 @@ def test_code_blocks_fit_the_column_at_1280_px(rendered):
     assert len(wide_blocks(rendered[PROBE])) == 1                            # and a wide one is caught
 
 
+@BUILT_SITE
 def test_pictures_are_shown_readably_with_click_to_zoom(rendered):
     """A picture is shown at least half its file's width, or a click opens it full size; never narrower than
     READABLE_PX (or its own width); and every picture loaded."""
@@ -503,6 +514,7 @@ def test_pictures_are_shown_readably_with_click_to_zoom(rendered):
     assert len(caught) == 2 and "no click" in caught[0] and "only" in caught[1], caught
 
 
+@BUILT_SITE
 def test_equations_are_typeset_by_the_sites_own_katex(rendered):
     assert _each_page(rendered, untypeset) == {}
     for page in ("background/physics", "background/accuracy", "background/validation"):
@@ -510,6 +522,7 @@ def test_equations_are_typeset_by_the_sites_own_katex(rendered):
     assert untypeset(rendered[PROBE]) == [r"\frac{1}{"]
 
 
+@BUILT_SITE
 def test_pages_need_no_network_and_log_no_error(rendered):
     """Fonts, KaTeX, the lightbox and the notebooks' outputs all come from the site; Material's star count of
     the repository is the one request that may leave it (the page works without it)."""
