@@ -82,6 +82,10 @@ from .sdirk_bodies import place_stage, take_back_half_bodies, take_body_update
 DEFAULT_RHO_INF = 0.9
 NEWTON_TOL = 1e-9        # on the largest position update, times the shortest segment: a strain of 1e-9 (EA 1e-9,
 # 1.7 N on WD0050's chain; SDIRK2's 1e-11 cost galpha two to three more iterations a step at a mooring's steps)
+NEWTON_TOL_STEP = 0.01   # [s] below this fixed step Newton's tolerance shrinks with the step, down to NEWTON_TOL_FLOOR:
+# the velocity update is the position update times 1 / (beta_v dt), so a fixed strain left per step grows into the
+# velocities as the step shrinks (a tumbling body's quaternion stopped converging below 0.3 ms at 1e-9)
+NEWTON_TOL_FLOOR = 1e-11  # SDIRK2's
 NEWTON_STRAIN = 1e-6      # with adaptive steps Newton stops at a hundredth of the tolerance, but at most this strain
 # of the shortest segment (an unconverged solve is an error in every segment's force balance, EA times it)
 NEWTON_MAX_ITER = 60     # residual evaluations per step, halvings included
@@ -182,7 +186,8 @@ class GeneralizedAlphaFamily(Integrator):
         w, cyclic = band_width(any(line.closed for line in model.lines), n, coupling_reach(scene))
         nt, m = dim * n, w * dim
         jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
-        tol = NEWTON_TOL * min(line.segment_length for line in model.lines)
+        shortest = min(line.segment_length for line in model.lines)
+        tol = shortest * max(NEWTON_TOL_FLOOR, NEWTON_TOL * min(1.0, grid.dt / NEWTON_TOL_STEP))
         grouped = {WITH_JUNCTIONS.name, WITH_BODIES.name} & model.switches
         groups = model_groups(model, w) if grouped else None   # a rope's: none
         body = body_alpha(model, groups) if WITH_BODIES.name in model.switches else None
@@ -213,8 +218,8 @@ class GeneralizedAlphaFamily(Integrator):
         if tol is not None:   # the scheme's own steps; x, v on the grid by dense output
             rtol = scene.integrator.relative_tolerance or 0.0
             self.adapt = new_adapt(self.x, self.v, self.ledger, grid.dt, tol, rtol)
-            strain = NEWTON_STRAIN * min(line.segment_length for line in model.lines)
-            self.newton = self.newton._replace(tol=max(self.newton.tol, min(NEWTON_FRACTION * tol, strain)))
+            strain = NEWTON_STRAIN * shortest
+            self.newton = self.newton._replace(tol=max(NEWTON_TOL * shortest, min(NEWTON_FRACTION * tol, strain)))
             for name in self.adapt._fields:
                 setattr(self, f"adapt_{name}", getattr(self.adapt, name))
             self.STATE += tuple(f"adapt_{name}" for name in self.adapt._fields)
