@@ -244,7 +244,7 @@ def body_energy_numpy(bundle: Bodies, pose: np.ndarray, twist: np.ndarray, g: fl
 # ------------------------------------------------------------------------------------------ compiled
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def place_attachments(x, v, bodies, pose, twist):
     """Put every attachment node where its body holds it: x_i = r + R s_i, v_i = v + w x R s_i."""
     dim = x.shape[0]
@@ -332,7 +332,7 @@ def _ldl_factor(a, n):
 def _varying_mass(work, mass0, b, n, tangent, arm, k0, k1):
     """Body b's mass matrix in its axes into ``work``'s lower triangle: the constant part ``mass0[b]`` plus each
     attachment k0 <= k < k1's rank-one term c d d^T at its arm s, u = (d, s x d) on the n kept rows (``tangent``:
-    the chords d and the factors c). n is a constant at every call (6 or 3), so the loops unroll."""
+    the chords d and the factors c)."""
     for i in range(n):
         for j in range(i + 1):
             work[i, j] = mass0[b, i, j]
@@ -497,7 +497,7 @@ def body_attachments_system(work, x, acc, inv_mass, around, bodies, pose, twist,
         work[5, 6] += m2
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist, out, t, moved):
     """The free bodies' accelerations (see the module doc) into ``out`` (6, B) (a, then alpha), from ``acc``
     holding each attachment node's F_i / m_i, and every attachment's acceleration a + alpha x rho + w x (w x rho)
@@ -547,18 +547,15 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
                 g0, g1, g2 = g0 - along * d0, g1 - along * d1, g2 - along * d2
             h0, h1, h2 = cross(s0, s1, s2, g0, g1, g2)
             f0, f1, f2, m0, m1, m2 = f0 + g0, f1 + g1, f2 + g2, m0 + h0, m1 + h1, m2 + h2
-        if n == 3:   # the kept rows' right-hand side: x, y and the turn about z in 2-D
-            if refactor:
-                _varying_mass(work, bodies.mass0, b, 3, tangent, arm, start[b], start[b + 1])
-                _ldl_factor(work, 3)
-            work[0, 6], work[1, 6], work[2, 6] = f0, f1, m2
-            _ldl_solve(work if bodies.varies[b] != 0 else bodies.factor[b], 3, work)
+        if refactor:
+            _varying_mass(work, bodies.mass0, b, n, tangent, arm, start[b], start[b + 1])
+            _ldl_factor(work, n)
+        work[0, 6], work[1, 6] = f0, f1   # the kept rows' right-hand side: x, y and the turn about z in 2-D
+        if n == 3:
+            work[2, 6] = m2
         else:
-            if refactor:
-                _varying_mass(work, bodies.mass0, b, 6, tangent, arm, start[b], start[b + 1])
-                _ldl_factor(work, 6)
-            work[0, 6], work[1, 6], work[2, 6], work[3, 6], work[4, 6], work[5, 6] = f0, f1, f2, m0, m1, m2
-            _ldl_solve(work if bodies.varies[b] != 0 else bodies.factor[b], 6, work)
+            work[2, 6], work[3, 6], work[4, 6], work[5, 6] = f2, m0, m1, m2
+        _ldl_solve(work if bodies.varies[b] != 0 else bodies.factor[b], n, work)
         if n == 3:   # 2-D: x, y and the turn about z
             ab0, ab1, ab2, alb0, alb1, alb2 = work[0, 6], work[1, 6], 0.0, 0.0, 0.0, work[2, 6]
         else:
