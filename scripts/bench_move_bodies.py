@@ -3,8 +3,9 @@ revision's, in one process.
 
 The other revision's ropesim/model/bodies.py is loaded beside this checkout's (it must import against this
 checkout's package: its helpers, rotation and fluid modules, unchanged since); each version is called in a
-compiled loop on the same model, state and node forces, interleaved rounds; the table shows each one's median
-time per call and the median of the per-round ratios. Scenes: spread_mooring_free (three chains whose tangential
+compiled loop on the same model, state and node forces (each with its own revision's parameter bundle), interleaved
+rounds, timed in CPU time (steadier than wall time on the shared machine); the table shows each one's median time
+per call and the median of the per-round ratios. Scenes: spread_mooring_free (three chains whose tangential
 added mass differs from their normal one, in a current) and helicopter_sling (a container on four legs in air).
 
     python scripts/bench_move_bodies.py a3e4949 [--rounds 7] [--calls 200000]
@@ -44,15 +45,24 @@ def other_bodies(rev: str, folder: Path):
 
 
 def loop_of(move):
-    """A compiled loop calling ``move`` (a move_bodies specialised for the scene) n times."""
+    """A compiled loop calling ``move`` (a move_bodies specialised for the scene) n times (with ``moved`` True,
+    where the revision's move_bodies takes it)."""
     import numba
 
-    @numba.njit
-    def loop(n, x, v, acc, inv_mass, around, flow, bodies, pose, twist, out):
-        s = 0.0
-        for _ in range(n):
-            s += move(x, v, acc, inv_mass, around, 9.81, flow, bodies, pose, twist, out, 0.5)
-        return s
+    if move.py_func.__code__.co_argcount == 13:
+        @numba.njit(_nrt=False)
+        def loop(n, x, v, acc, inv_mass, around, flow, bodies, pose, twist, out):
+            s = 0.0
+            for _ in range(n):
+                s += move(x, v, acc, inv_mass, around, 9.81, flow, bodies, pose, twist, out, 0.5, True)
+            return s
+    else:
+        @numba.njit(_nrt=False)
+        def loop(n, x, v, acc, inv_mass, around, flow, bodies, pose, twist, out):
+            s = 0.0
+            for _ in range(n):
+                s += move(x, v, acc, inv_mass, around, 9.81, flow, bodies, pose, twist, out, 0.5)
+            return s
     return loop
 
 
@@ -63,8 +73,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--calls", type=int, default=200000)
     args = parser.parse_args(argv)
     import ropesim
-    from ropesim.model import jit
-    from ropesim.model.bodies import move_bodies
+    from ropesim.model import jit, terms
+    from ropesim.model.bodies import bodies_bundle, move_bodies
     from ropesim.model.build import build
 
     with tempfile.TemporaryDirectory() as folder:
@@ -73,7 +83,13 @@ def main(argv: list[str] | None = None) -> int:
         print("| --- | --- | --- | --- |")
         for name, sets in SCENES.items():
             model = build(ropesim.load_scene(name, sets))
+            terms.bodies_bundle = other.bodies_bundle   # the other revision's bundle, for its move_bodies
+            try:
+                theirs = build(ropesim.load_scene(name, sets)).params.bodies
+            finally:
+                terms.bodies_bundle = bodies_bundle
             p = model.params
+            bundles = {"other": theirs, "this": p.bodies}
             rng = np.random.default_rng(1)
             x = model.x0.copy()
             v, acc = rng.normal(size=x.shape) * 0.1, rng.normal(size=x.shape)
@@ -83,12 +99,13 @@ def main(argv: list[str] | None = None) -> int:
                      "this": loop_of(jit.specialise(move_bodies, model.switches))}
             walls: dict[str, list[float]] = {k: [] for k in loops}
             for key, loop in loops.items():   # compile
-                loop(10, x, v, acc.copy(), p.inv_mass, p.neighbours, p.flow, p.bodies, pose, twist, out)
+                loop(10, x, v, acc.copy(), p.inv_mass, p.neighbours, p.flow, bundles[key], pose, twist, out)
             for _ in range(args.rounds):
                 for key, loop in loops.items():
-                    started = time.perf_counter()
-                    loop(args.calls, x, v, acc.copy(), p.inv_mass, p.neighbours, p.flow, p.bodies, pose, twist, out)
-                    walls[key].append((time.perf_counter() - started) / args.calls)
+                    started = time.thread_time()
+                    loop(args.calls, x, v, acc.copy(), p.inv_mass, p.neighbours, p.flow, bundles[key], pose, twist,
+                         out)
+                    walls[key].append((time.thread_time() - started) / args.calls)
             print(f"| {name} | {median(walls['other']) * 1e9:.0f} ns | {median(walls['this']) * 1e9:.0f} ns | "
                   f"{median_ratio(walls['other'], walls['this']):.2f} |", flush=True)
     print(f"\n{load_note()}")

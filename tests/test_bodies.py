@@ -380,8 +380,9 @@ def test_the_body_axes_solve_equals_the_world_axes_equations(case):
     """move_bodies solves each body's equations in its own axes, with the constant part of its mass matrix
     factored once and its attachments' tangential added mass ((a_t - a_n) q q^T, the spar's chains and the tripod's
     lines in water) added per evaluation: at a tilted, turning pose with arbitrary node forces its accelerations
-    equal the world-axes assembly solved by numpy to round-off (1e-12 of their size), and the attachment nodes
-    get a + alpha x rho + w x (w x rho)."""
+    equal the world-axes assembly solved by numpy to round-off (1e-12 of their size), again with the factor reused
+    at the same positions (a velocity kick's sub-stages), and the attachment nodes get a + alpha x rho +
+    w x (w x rho)."""
     from test_sdirk_bodies import tumbling_tripod
     from synthetic_system import BODY_2D
     from ropesim.model import jit
@@ -404,9 +405,20 @@ def test_the_body_axes_solve_equals_the_world_axes_equations(case):
     got, node_acc = np.zeros_like(want), acc.copy()
     p = model.params
     mover = jit.specialise(move_bodies, model.switches)
-    mover(x, v, node_acc, p.inv_mass, p.neighbours, 9.81, p.flow, p.bodies, pose, twist, got, 0.5)
+    mover(x, v, node_acc, p.inv_mass, p.neighbours, 9.81, p.flow, p.bodies, pose, twist, got, 0.5, True)
     for d in range(2):   # forces and moments: each to 1e-12 of its largest
         assert np.abs(got[3 * d:3 * d + 3] - want[3 * d:3 * d + 3]).max() <= 1e-12 * np.abs(want[3 * d:3 * d + 3]).max()
+    # a velocity kick's next sub-stage: the same positions and pose, other node forces and twist; the matrix
+    # factored above is reused (moved=False), and the answer is still the world-axes solve's
+    acc2, twist2 = rng.normal(size=x.shape) * 50.0, rng.normal(size=twist.shape) * 0.3
+    if model.dim == 2:
+        twist2[[2, 3, 4]] = 0.0
+    again = np.zeros_like(want)
+    mover(x, v, acc2.copy(), p.inv_mass, p.neighbours, 9.81, p.flow, p.bodies, pose, twist2, again, 0.5, False)
+    want2 = _world_axes_accelerations(model, x, v, acc2, pose, twist2, 0.5)
+    for d in range(2):
+        assert np.abs(again[3 * d:3 * d + 3] - want2[3 * d:3 * d + 3]).max() <= \
+            1e-12 * np.abs(want2[3 * d:3 * d + 3]).max()
     bundle = p.bodies
     for b in range(pose.shape[1]):
         r = rotation_matrix(pose[3:, b])

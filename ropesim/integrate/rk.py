@@ -156,7 +156,7 @@ def combine(x, v, kx, kv, b, h):
             v[d, i] += h * dv
 
 
-@jit.kernel
+@jit.kernel(inline="always")
 def body_stage(bodies, scratch, a, st, h):
     """Stage ``st``'s body state into the scratch's pose, twist and rotation vector: r + h sum_j a[st, j] v_j,
     phi = h sum_j a[st, j] phi'_j, q = exp(phi) q_n, and the twist likewise."""
@@ -180,7 +180,7 @@ def body_stage(bodies, scratch, a, st, h):
         turn(scratch.pose[3:7], b, scratch.phi[0, b], scratch.phi[1, b], scratch.phi[2, b])
 
 
-@jit.kernel
+@jit.kernel(inline="always")
 def body_rates(scratch, st):
     """Stage ``st``'s position-like derivatives: the velocity v and the rotation vector's rate dexp^-1_phi(w)."""
     twist, phi = scratch.twist, scratch.phi
@@ -193,7 +193,7 @@ def body_rates(scratch, st):
         scratch.kpose[st, 5, b] = r2
 
 
-@jit.kernel
+@jit.kernel(inline="always")
 def combine_bodies(bodies, scratch, b_weights, h):
     """The step's end for the bodies: r += h sum_s b_s v_s, q <- exp(h sum_s b_s phi'_s) q, twist likewise."""
     pose, twist = bodies

@@ -84,7 +84,8 @@ def velocity_kick(x, v, acc_x, tau, t, params, mass, gamma, held, scratch, bodie
                 p_drag += gamma[i] * mass[i] * y[d, i] * y[d, i]
         p_fluid += solve_accelerations(x, y, a, params)
         if WITH_BODIES:
-            p_fluid += body_accelerations(x, y, a, params, bodies.pose, scratch.body_y, scratch.body_slopes[s], t)
+            p_fluid += body_accelerations(x, y, a, params, bodies.pose, scratch.body_y, scratch.body_slopes[s], t,
+                                          s == 0)   # positions frozen: the bodies' mass matrices factored once
         p_box = 0.0
         if WITH_APPLIED:
             applied_accelerations(x, y, a_box, params)

@@ -50,8 +50,9 @@ body axes [kg m^2], ``lift`` (B,) rho V g [N], ``drag`` (3, B) 1/2 rho CdA [kg/m
 ``node_added`` (2, K) [kg] (a_n, a_t: the per-node added-mass pass leaves them to this one); ``mass0`` (B, 6, 6)
 the constant part of each body's mass matrix in body axes and ``factor`` (B, 6, 6) its L D L^T, on the kept rows
 ``rows`` (6 in 3-D, x, y and the turn about z in 2-D: the leading n x n of each), ``varies`` (B,) whether a body
-has attachments with a_t != a_n; ``attached_mass`` (K,) [kg] the attachments' masses; scratch: ``tangent`` (3, K)
-their lines' tangents in body axes, ``work`` (6, 7) the solve's.
+has attachments with a_t != a_n; ``attached_mass`` (K,) [kg] the attachments' masses; scratch: ``tangent`` (4, K)
+the chords along their lines in body axes d (the tangent q = d / |d|) and (a_t - a_n) / |d|^2, ``work`` (B, 6, 7)
+each body's solve (a varying body's factor kept there for the next call at the same positions).
 """
 
 from __future__ import annotations
@@ -181,7 +182,7 @@ def bodies_bundle(scene, ends: dict[str, list[int]], added: np.ndarray, node_mas
     return Bodies(mass, out["cog"], inertia, lift, out["cob"], out["drag"], out["drag_rot"], out["added"],
                   out["added_rot"], out["spring"], out["damper"], out["rest"], start, node_index, arm, node_added,
                   mass0, factor, varies, rows.astype(np.int64), 1.0 / (1.0 / node_mass[node_index]),
-                  np.zeros((3, len(nodes))), np.zeros((6, 7)))
+                  np.zeros((4, len(nodes))), np.zeros((count, 6, 7)))
 
 
 def mass_at(mass: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -328,6 +329,30 @@ def _ldl_factor(a, n):
             for k in range(j):
                 s -= a[i, k] * a[j, k] * a[k, k]
             a[i, j] = s * inverse
+
+
+@jit.kernel(inline="always")
+def _varying_mass(work, mass0, b, n, tangent, arm, k0, k1):
+    """Body b's mass matrix in its axes into ``work``'s lower triangle: the constant part ``mass0[b]`` plus each
+    attachment k0 <= k < k1's rank-one term c d d^T at its arm s, u = (d, s x d) on the n kept rows (``tangent``:
+    the chords d and the factors c)."""
+    for i in range(n):
+        for j in range(i + 1):
+            work[i, j] = mass0[b, i, j]
+    for k in range(k0, k1):
+        c = tangent[3, k]
+        if c != 0.0:
+            d0, d1, d2 = tangent[0, k], tangent[1, k], tangent[2, k]
+            t0, t1, t2 = cross(arm[0, k], arm[1, k], arm[2, k], d0, d1, d2)
+            work[0, 6], work[1, 6] = d0, d1
+            if n == 3:
+                work[2, 6] = t2
+            else:
+                work[2, 6], work[3, 6], work[4, 6], work[5, 6] = d2, t0, t1, t2
+            for i in range(n):
+                ci = c * work[i, 6]
+                for j in range(i + 1):
+                    work[i, j] += ci * work[j, 6]
 
 
 @jit.kernel(inline="always")
@@ -480,7 +505,7 @@ def body_attachments_system(work, x, acc, inv_mass, around, bodies, pose, twist,
 
 
 @jit.kernel
-def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist, out, t):
+def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist, out, t, moved):
     """The free bodies' accelerations (see the module doc) into ``out`` (6, B) (a, then alpha), from ``acc``
     holding each attachment node's F_i / m_i, and every attachment's acceleration a + alpha x rho + w x (w x rho)
     into ``acc``; returns the power [W] of the fluid's forces on the bodies (drag and added mass).
@@ -488,10 +513,12 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
     Solved in the body's axes, where its mass matrix is constant but for its attachments' added mass along their
     lines' tangents, (a_t - a_n) q q^T at each arm, a rank-one term u u^T with u = (q, s x q): the constant part
     is factored once (``bodies.factor``, :func:`bodies_bundle`), and a body with such terms adds them to it and
-    factors its 6 x 6 (3 x 3 in 2-D) matrix per evaluation. The stiff integrator's Newton solve assembles the same
-    equations in world axes (:func:`body_own_system`, :func:`body_attachments_system`)."""
+    factors its 6 x 6 (3 x 3 in 2-D) matrix per evaluation; with ``moved`` False (the nodes and the bodies' poses
+    where they were at the last call: the sub-stages of a velocity kick) it reuses that call's chords and factor.
+    The stiff integrator's Newton solve assembles the same equations in world axes (:func:`body_own_system`,
+    :func:`body_attachments_system`)."""
     dim = x.shape[0]
-    work = bodies.work
+    tangent = bodies.tangent
     start, nodes, arm, node_added = bodies.start, bodies.nodes, bodies.arm, bodies.node_added
     n = bodies.rows.shape[0]
     power = 0.0
@@ -499,11 +526,8 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
         r = matrix_of(pose[3:7], b)
         w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
         wb0, wb1, wb2 = rotate_back(r, w0, w1, w2)
-        varies = bodies.varies[b] != 0
-        if varies:
-            for i in range(n):
-                for j in range(i + 1):
-                    work[i, j] = bodies.mass0[b, i, j]
+        work = bodies.work[b]
+        refactor = moved and bodies.varies[b] != 0
         f0, f1, f2, m0, m1, m2, own = own_load(gravity, flow, bodies, pose, twist, b, t, r)
         power += own
         for k in range(start[b], start[b + 1]):   # each attachment's force less its centripetal part
@@ -516,35 +540,29 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
             n0, n1, n2 = cross(wb0, wb1, wb2, e0, e1, e2)   # w x (w x s)
             mn = mi + a_n
             g0, g1, g2 = g0 - mn * n0, g1 - mn * n1, g2 - mn * n2
-            extra = a_t - a_n
-            if extra != 0.0:
-                q = node_tangent(x, i, around)
-                q0, q1, q2 = rotate_back(r, q[0], q[1], q[2])
-                bodies.tangent[0, k], bodies.tangent[1, k], bodies.tangent[2, k] = q0, q1, q2
-                along = extra * (q0 * n0 + q1 * n1 + q2 * n2)
-                g0, g1, g2 = g0 - along * q0, g1 - along * q1, g2 - along * q2
-                t0, t1, t2 = cross(s0, s1, s2, q0, q1, q2)   # u = (q, s x q) on the kept rows, in column 6
-                work[0, 6], work[1, 6] = q0, q1
-                if n == 3:
-                    work[2, 6] = t2
+            if a_t != a_n:   # (a_t - a_n) q q^T = c d d^T with d the chord along the line, c = (a_t - a_n) / |d|^2
+                if moved:
+                    lo, hi = around[0, i], around[1, i]
+                    d0, d1, d2 = rotate_back(r, x[0, hi] - x[0, lo], x[1, hi] - x[1, lo],
+                                             x[2, hi] - x[2, lo] if dim == 3 else 0.0)
+                    chord = d0 * d0 + d1 * d1 + d2 * d2
+                    c = (a_t - a_n) / chord if chord > 0.0 else 0.0
+                    tangent[0, k], tangent[1, k], tangent[2, k], tangent[3, k] = d0, d1, d2, c
                 else:
-                    work[2, 6], work[3, 6], work[4, 6], work[5, 6] = q2, t0, t1, t2
-                for a in range(n):
-                    ua = extra * work[a, 6]
-                    for c in range(a + 1):
-                        work[a, c] += ua * work[c, 6]
+                    d0, d1, d2, c = tangent[0, k], tangent[1, k], tangent[2, k], tangent[3, k]
+                along = c * (d0 * n0 + d1 * n1 + d2 * n2)
+                g0, g1, g2 = g0 - along * d0, g1 - along * d1, g2 - along * d2
             h0, h1, h2 = cross(s0, s1, s2, g0, g1, g2)
             f0, f1, f2, m0, m1, m2 = f0 + g0, f1 + g1, f2 + g2, m0 + h0, m1 + h1, m2 + h2
-        work[0, 6], work[1, 6] = f0, f1
+        if refactor:
+            _varying_mass(work, bodies.mass0, b, n, tangent, arm, start[b], start[b + 1])
+            _ldl_factor(work, n)
+        work[0, 6], work[1, 6] = f0, f1   # the kept rows' right-hand side: x, y and the turn about z in 2-D
         if n == 3:
             work[2, 6] = m2
         else:
             work[2, 6], work[3, 6], work[4, 6], work[5, 6] = f2, m0, m1, m2
-        if varies:
-            _ldl_factor(work, n)
-            _ldl_solve(work, n, work)
-        else:
-            _ldl_solve(bodies.factor[b], n, work)
+        _ldl_solve(work if bodies.varies[b] != 0 else bodies.factor[b], n, work)
         if n == 3:   # 2-D: x, y and the turn about z
             ab0, ab1, ab2, alb0, alb1, alb2 = work[0, 6], work[1, 6], 0.0, 0.0, 0.0, work[2, 6]
         else:
@@ -570,11 +588,11 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
                 acc[2, i] = k2
             a_n, a_t = node_added[0, k], node_added[1, k]
             if a_n != 0.0 or a_t != 0.0:   # the fluid's inertial force -A_i a_i on the node, at its velocity
-                h0, h1, h2 = a_n * kb0, a_n * kb1, a_n * kb2   # in body axes, with the tangent kept above
+                h0, h1, h2 = a_n * kb0, a_n * kb1, a_n * kb2   # in body axes, with the chord kept above
                 if a_t != a_n:
-                    q0, q1, q2 = bodies.tangent[0, k], bodies.tangent[1, k], bodies.tangent[2, k]
-                    along = (a_t - a_n) * (kb0 * q0 + kb1 * q1 + kb2 * q2)
-                    h0, h1, h2 = h0 + along * q0, h1 + along * q1, h2 + along * q2
+                    d0, d1, d2 = tangent[0, k], tangent[1, k], tangent[2, k]
+                    along = tangent[3, k] * (kb0 * d0 + kb1 * d1 + kb2 * d2)
+                    h0, h1, h2 = h0 + along * d0, h1 + along * d1, h2 + along * d2
                 u0, u1, u2 = rotate_back(r, v[0, i], v[1, i], v[2, i] if dim == 3 else 0.0)
                 power -= h0 * u0 + h1 * u1 + h2 * u2
     return power

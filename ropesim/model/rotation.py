@@ -115,23 +115,48 @@ def cross(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
+#: Below this squared angle [rad^2] (|p| < 0.1) the rotation's half-angle functions are their Taylor series to
+#: a^8: the first term left out is below 1e-19 of the sum, so the series equals the trigonometric form to within
+#: rounding, without cos, sin, tan or sqrt (a step's rotation is far below it but for a body spun very fast).
+SERIES_BELOW = 1e-2
+
+
+@jit.kernel(inline="always")
+def half_turn(a2):
+    """cos(a / 2) and sin(a / 2) / a of the angle a [rad] whose square is ``a2``: exp(p)'s scalar part and the
+    factor of p in its vector part."""
+    if a2 < SERIES_BELOW:
+        return (1.0 + a2 * (-1.0 / 8.0 + a2 * (1.0 / 384.0 + a2 * (-1.0 / 46080.0 + a2 / 10321920.0))),
+                0.5 + a2 * (-1.0 / 48.0 + a2 * (1.0 / 3840.0 + a2 * (-1.0 / 645120.0 + a2 / 185794560.0))))
+    angle = math.sqrt(a2)
+    return math.cos(0.5 * angle), math.sin(0.5 * angle) / angle
+
+
+@jit.kernel(inline="always")
+def unit_scale(n2):
+    """1 / sqrt(n2) for a quaternion's squared norm n2: 3/2 - n2/2 (Newton's step from 1) when n2 is within
+    1e-8 of 1, as a product of two unit quaternions is to within rounding (the error, 3/8 (n2 - 1)^2, is below
+    half a unit in the last place), so renormalising each turn takes no square root and no division."""
+    if abs(n2 - 1.0) < 1e-8:
+        return 1.5 - 0.5 * n2
+    return 1.0 / math.sqrt(n2)
+
+
 @jit.kernel(inline="always")
 def turn(q, b, p0, p1, p2):
     """q[:, b] <- exp(p) q[:, b], normalised: the orientation turned by the world-frame rotation vector p [rad]."""
-    angle = math.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
-    c = math.cos(0.5 * angle)
-    s = 0.5 - angle * angle / 48.0 if angle < 1e-4 else math.sin(0.5 * angle) / angle   # sin(a / 2) / a
+    c, s = half_turn(p0 * p0 + p1 * p1 + p2 * p2)
     e0, e1, e2, e3 = c, s * p0, s * p1, s * p2
     w, x, y, z = q[0, b], q[1, b], q[2, b], q[3, b]
     n0 = e0 * w - e1 * x - e2 * y - e3 * z
     n1 = e0 * x + e1 * w + e2 * z - e3 * y
     n2 = e0 * y - e1 * z + e2 * w + e3 * x
     n3 = e0 * z + e1 * y - e2 * x + e3 * w
-    norm = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2 + n3 * n3)
-    q[0, b] = n0 / norm
-    q[1, b] = n1 / norm
-    q[2, b] = n2 / norm
-    q[3, b] = n3 / norm
+    scale = unit_scale(n0 * n0 + n1 * n1 + n2 * n2 + n3 * n3)
+    q[0, b] = n0 * scale
+    q[1, b] = n1 * scale
+    q[2, b] = n2 * scale
+    q[3, b] = n3 * scale
 
 
 @jit.kernel(inline="always")
@@ -139,8 +164,8 @@ def dexp_inverse(p0, p1, p2, w0, w1, w2):
     """dexp^-1_p(w): the rate of the rotation vector p of q = exp(p) q0 when the body turns at the world-frame rate
     w, p' = w - p x w / 2 + (1 - (a / 2) cot(a / 2)) / a^2 p x (p x w), a = |p|."""
     a2 = p0 * p0 + p1 * p1 + p2 * p2
-    if a2 < 1e-8:
-        k = 1.0 / 12.0 + a2 / 720.0
+    if a2 < SERIES_BELOW:   # the series to a^8 (see SERIES_BELOW)
+        k = 1.0 / 12.0 + a2 * (1.0 / 720.0 + a2 * (1.0 / 30240.0 + a2 * (1.0 / 1209600.0 + a2 / 47900160.0)))
     else:
         a = math.sqrt(a2)
         k = (1.0 - 0.5 * a / math.tan(0.5 * a)) / a2

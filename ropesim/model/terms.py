@@ -213,12 +213,14 @@ def solve_accelerations(x, v, acc, p):
 
 
 @jit.kernel(inline="always")
-def body_accelerations(x, v, acc, p, pose, twist, out, t):
+def body_accelerations(x, v, acc, p, pose, twist, out, t, moved=True):
     """The free bodies' accelerations into ``out`` (6, B) and their attachments' into ``acc``, from ``acc`` holding
     every force / m (:func:`ropesim.model.bodies.move_bodies`), the bodies at ``pose``, ``twist`` at time t [s];
-    returns the power [W] of the fluid's forces on the bodies. Called after :func:`solve_accelerations`."""
+    returns the power [W] of the fluid's forces on the bodies. Called after :func:`solve_accelerations`.
+    ``moved`` False: the nodes and the poses are where they were at the last call (a velocity kick's sub-stage),
+    so the bodies' mass matrices are too."""
     g = p.gravity[0] if WITH_GRAVITY else 0.0
-    return move_bodies(x, v, acc, p.inv_mass, p.neighbours, g, p.flow, p.bodies, pose, twist, out, t)
+    return move_bodies(x, v, acc, p.inv_mass, p.neighbours, g, p.flow, p.bodies, pose, twist, out, t, moved)
 
 
 @jit.kernel(inline="always")
