@@ -233,6 +233,9 @@ def _check_floating(run, tolerance):
     assert 4100.0 / (RHO * 8.0) == pytest.approx(0.5)   # Archimedes: half under, its centre at the mean level
     np.testing.assert_allclose(heave, 0.3 * np.cos(w * run.t), rtol=0, atol=tolerance * 0.3)
     assert np.abs(run.body("box").position[:, [0, 2]]).max() < 1e-6
+    # the submerged fraction reported per frame: 1/2 - heave / h, between 0.35 and 0.65
+    np.testing.assert_allclose(run.body("box").submerged, 0.5 - 0.3 * np.cos(w * run.t) / 2.0, rtol=0,
+                               atol=tolerance * 0.3 / 2.0)
     ledger = run.summary["energy_ledger"]
     assert abs(ledger["residual_J"]) < 1e-5 * ledger["energy_flowed_J"]
 
@@ -244,6 +247,14 @@ def test_a_floating_box_rests_at_archimedes_draught_and_heaves_at_its_waterplane
 @pytest.mark.slow
 def test_sdirk2_floats_the_box_alike():
     _check_floating(_float_run("sdirk2", 0.01), 1e-3)
+
+
+def test_under_moordyns_rule_the_reported_fraction_is_whole():
+    text = FLOAT.replace("METHOD", "verlet").replace("DT", "0.001").replace("t_end = 6.0", "t_end = 0.5")
+    run = ropesim.simulate(ropesim.scene_from_toml(text.replace("level = 0.0\n", 'level = 0.0\nfraction = "moordyn"\n'),
+                                                   source="floating_box.toml"))
+    assert np.array_equal(run.body("box").submerged, np.ones(len(run.t)))
+    assert run.body("box").position[-1, 1] > 0.3   # whole buoyancy, twice its weight: it rises
 
 
 def test_only_scenes_with_free_bodies_in_a_sea_compile_the_bodies_sea():

@@ -28,6 +28,7 @@ from functools import cached_property
 
 import numpy as np
 
+from ..model.body_sea import body_fraction
 from ..model.forces.springs import segment_forces, segment_strains
 from ..model.layout import LineLayout, line_layouts
 from .rotation import angles_from_quaternion, continuous_angles, rotation_matrix
@@ -292,7 +293,10 @@ class BodyResults:
     - ``points``: the ids of the points on it;
     - ``line_forces`` {line id: (F, D) [N]} and ``line_moments`` {line id: (F, 3) [N m] ((F, 1) in 2-D)}: what
       each line attached to it puts on it, the moment about its reference point; ``force`` and ``moment`` their
-      sums (see the module for the sign conventions).
+      sums (see the module for the sign conventions);
+    - ``submerged`` (F,): a free body's fraction of its displaced volume below the instantaneous surface, under a
+      ``[sea]``, as its loads take it (:mod:`ropesim.model.body_sea`: vertical-walled, its ``height`` about its
+      centre of buoyancy; 1 under MoorDyn's rule); None without a sea or for a fixed or driven body.
     """
 
     def __init__(self, traj, index: int):
@@ -357,6 +361,15 @@ class BodyResults:
     @property
     def line_moments(self) -> dict[str, np.ndarray]:
         return self._wrench[1]
+
+    @cached_property
+    def submerged(self) -> np.ndarray | None:
+        scene = self.traj.scene
+        if scene.sea is None or self.kind != "free":
+            return None
+        run = self.traj.internal   # the y-up frame the model computes in
+        return body_fraction(scene, scene.rigid_bodies[self.index], run.t, run.body_x[:, self.index],
+                             run.body_q[:, self.index])
 
     @cached_property
     def force(self) -> np.ndarray:

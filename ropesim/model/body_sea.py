@@ -55,7 +55,7 @@ from .forces.fluid import WITH_FLOW, flow_at, flow_scaled
 from .forces.sea import AIR_RATIO, FRACTION_RULE, MOORDYN_RULE, WIND_X, WIND_Y, WIND_Z, WITH_WAVES
 from .ramp import ramp_rate
 from .rotation import cross, rotate_back
-from .waves import LEVEL, water_at
+from .waves import LEVEL, wave_field, water_at
 
 WITH_BODY_SEA = jit.Switch("body_sea", "free rigid bodies under a sea's free surface")
 
@@ -81,12 +81,33 @@ def submerged_fraction(y_cob, surface, height):
     return np.clip((np.asarray(surface) - np.asarray(y_cob)) / height + 0.5, 0.0, 1.0)
 
 
+def body_fraction(scene, body, t, position, quaternion) -> np.ndarray:
+    """(F,) the submerged fraction of the free rigid ``body`` (one of ``scene.rigid_bodies``) at the saved frames:
+    times ``t`` (F,) [s], its reference point ``position`` (F, D) [m] and orientation ``quaternion`` (F, 4), all in
+    the y-up frame the model computes in. The f its loads take (module doc): the surface's height, waves and ramp
+    included, over its reference point, against its centre of buoyancy; 1 under MoorDyn's rule. NumPy, for
+    outputs (:class:`ropesim.analysis.objects.BodyResults`)."""
+    from .rotation import rotation_matrix
+
+    t = np.asarray(t, dtype=float)
+    if scene.sea.fraction == "moordyn":
+        return np.ones(len(t))
+    dim = scene.dimension
+    x = np.zeros((len(t), 3))
+    x[:, :dim] = np.asarray(position, dtype=float)[:, :dim]
+    cob = np.zeros(3)
+    cob[:dim] = np.asarray(body.center_of_buoyancy, dtype=float)[:dim]
+    y_cob = x[:, 1] + rotation_matrix(np.asarray(quaternion, dtype=float))[:, 1, :] @ cob
+    field = wave_field(scene)
+    eta = field.elevation(x[:, 0], t, x[:, 2]) if field is not None else np.zeros(len(t))
+    return submerged_fraction(y_cob, scene.sea.level + eta, body.height)
+
+
 def heave_stiffness(model, pose: np.ndarray, t: float) -> np.ndarray:
     """Each free body's heave stiffness [N/m] at ``pose`` (7, B) and time t [s]: rho g A_wp = lift / h while the
     surface cuts its walls, else 0 (and 0 everywhere without a sea or under MoorDyn's rule), as
     :func:`water_at_body` has it; NumPy, for the static solver's step matrix."""
     from .rotation import rotation_matrix
-    from .waves import wave_field
 
     bundle, scene = model.params.bodies, model.scene
     out = np.zeros(pose.shape[1])
