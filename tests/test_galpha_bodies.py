@@ -203,6 +203,7 @@ def test_the_free_spar_with_galpha_agrees_with_rk4():
     assert np.abs(reference.pose[:3] - it.model.body_pose0[:3]).max() > 1.0   # it did move
 
 
+@pytest.mark.slow   # a loop of galpha, a body and a sea that no other test compiles (33 s in CI's quick suite)
 def test_galpha_floats_a_box_under_a_sea_at_second_order():
     """The floating box of tests/test_body_sea.py (its waterplane's heave stiffness, added mass and the sea's
     buoyancy, issue 22), released 0.3 m high: its heave against the closed form 0.3 cos(w t) over 6 s at 10, 5
