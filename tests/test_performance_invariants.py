@@ -171,7 +171,9 @@ def test_the_compiled_term_list_holds_no_reference_count_call(tmp_path):
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=env, check=True).stdout
     counts = {name: (int(functions), int(calls)) for name, functions, calls in (line.split() for line in
                                                                                out.splitlines())}
-    assert counts["accelerations"][0] >= 3 and counts["advance_rk"][0] >= 10   # the functions were found
+    # the functions were found (the loop's own and its callees' definitions; no C wrappers since jit.OPTIONS
+    # makes kernels without them: 9 in the loop)
+    assert counts["accelerations"][0] >= 3 and counts["advance_rk"][0] >= 8
     assert counts == {name: (functions, 0) for name, (functions, _) in counts.items()}
 
 
