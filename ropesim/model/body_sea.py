@@ -54,7 +54,7 @@ from . import jit
 from .forces.fluid import WITH_FLOW, flow_at, flow_scaled
 from .forces.sea import AIR_RATIO, FRACTION_RULE, MOORDYN_RULE, WIND_X, WIND_Y, WIND_Z, WITH_WAVES
 from .ramp import ramp_rate
-from .rotation import cross, rotate_back
+from .rotation import cross, rotate_back, rotation_matrix
 from .waves import LEVEL, wave_field, water_at
 
 WITH_BODY_SEA = jit.Switch("body_sea", "free rigid bodies under a sea's free surface")
@@ -81,44 +81,40 @@ def submerged_fraction(y_cob, surface, height):
     return np.clip((np.asarray(surface) - np.asarray(y_cob)) / height + 0.5, 0.0, 1.0)
 
 
+def _fraction(scene, t, x, quaternion, cob, height) -> np.ndarray:
+    """(K,) f of bodies with reference points ``x`` (K, 3) [m], orientations ``quaternion`` (K, 4), centres of
+    buoyancy ``cob`` (K, 3) [m] in their frames and ``height`` [m] (K,), at times ``t`` [s] (K,) or one (y-up):
+    the surface's height, waves and ramp included, over each reference point against its centre of buoyancy."""
+    field = wave_field(scene)
+    eta = field.elevation(x[:, 0], t, x[:, 2]) if field is not None else 0.0
+    y_cob = x[:, 1] + np.einsum("kj,kj->k", rotation_matrix(quaternion)[:, 1, :], cob)
+    return submerged_fraction(y_cob, scene.sea.level + eta, height)
+
+
 def body_fraction(scene, body, t, position, quaternion) -> np.ndarray:
     """(F,) the submerged fraction of the free rigid ``body`` (one of ``scene.rigid_bodies``) at the saved frames:
     times ``t`` (F,) [s], its reference point ``position`` (F, D) [m] and orientation ``quaternion`` (F, 4), all in
-    the y-up frame the model computes in. The f its loads take (module doc): the surface's height, waves and ramp
-    included, over its reference point, against its centre of buoyancy; 1 under MoorDyn's rule. NumPy, for
+    the y-up frame the model computes in. The f its loads take (module doc); 1 under MoorDyn's rule. NumPy, for
     outputs (:class:`ropesim.analysis.objects.BodyResults`)."""
-    from .rotation import rotation_matrix
-
     t = np.asarray(t, dtype=float)
     if scene.sea.fraction == "moordyn":
         return np.ones(len(t))
     dim = scene.dimension
-    x = np.zeros((len(t), 3))
+    x, cob = np.zeros((len(t), 3)), np.zeros((len(t), 3))
     x[:, :dim] = np.asarray(position, dtype=float)[:, :dim]
-    cob = np.zeros(3)
-    cob[:dim] = np.asarray(body.center_of_buoyancy, dtype=float)[:dim]
-    y_cob = x[:, 1] + rotation_matrix(np.asarray(quaternion, dtype=float))[:, 1, :] @ cob
-    field = wave_field(scene)
-    eta = field.elevation(x[:, 0], t, x[:, 2]) if field is not None else np.zeros(len(t))
-    return submerged_fraction(y_cob, scene.sea.level + eta, body.height)
+    cob[:, :dim] = np.asarray(body.center_of_buoyancy, dtype=float)[:dim]
+    return _fraction(scene, t, x, np.asarray(quaternion, dtype=float), cob, body.height)
 
 
 def heave_stiffness(model, pose: np.ndarray, t: float) -> np.ndarray:
     """Each free body's heave stiffness [N/m] at ``pose`` (7, B) and time t [s]: rho g A_wp = lift / h while the
     surface cuts its walls, else 0 (and 0 everywhere without a sea or under MoorDyn's rule), as
     :func:`water_at_body` has it; NumPy, for the static solver's step matrix."""
-    from .rotation import rotation_matrix
-
     bundle, scene = model.params.bodies, model.scene
-    out = np.zeros(pose.shape[1])
     if bundle is None or bundle.sea is None or scene.sea.fraction == "moordyn":
-        return out
-    field = wave_field(scene)
-    eta = field.elevation(pose[0], t, pose[2]) if field is not None else np.zeros_like(out)
-    turned = rotation_matrix(pose[3:7].T)                                   # (B, 3, 3)
-    y_cob = pose[1] + np.einsum("bj,jb->b", turned[:, 1, :], bundle.cob)
+        return np.zeros(pose.shape[1])
     height = bundle.sea.rows[HEIGHT]
-    f = submerged_fraction(y_cob, scene.sea.level + eta, height)
+    f = _fraction(scene, t, pose[:3].T, pose[3:7].T, bundle.cob.T, height)
     return np.where((f > 0.0) & (f < 1.0), bundle.lift / height, 0.0)
 
 
