@@ -125,8 +125,8 @@ def rows_bodies(body, X, V, acc, c2, beta_v, t_f, nodes, params, groups, rhs):
     free, mass, drag = nodes
     bodies = params.bodies
     dim = X.shape[0]
-    for k in range(bodies.nodes.shape[0]):
-        i = bodies.nodes[k]
+    for k in range(bodies.links.shape[0]):   # bodies.index[k]: attachment k's node
+        i = bodies.index[k]
         if drag[i] != 0.0:
             for d in range(dim):
                 acc[d, i] -= drag[i] * V[d, i] / mass[i]
@@ -199,8 +199,8 @@ def raw_error_bodies(body, X, acc, co, h, t_f, params, groups, rhs):
             for c in range(k):
                 s += work[keep[a], keep[c]] * stage.out[keep[c], b]
             groups.own_rhs[at + a] = s
-        for c in range(bodies.start[b], bodies.start[b + 1]):
-            i = bodies.nodes[c]
+        for c in range(bodies.index[bodies.links.shape[0] + b], bodies.index[bodies.links.shape[0] + b + 1]):
+            i = bodies.index[c]
             for d in range(dim):
                 rhs[i * dim + d] = 0.0
 

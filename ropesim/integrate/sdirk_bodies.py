@@ -45,10 +45,11 @@ import numpy as np
 from ..model import jit
 from ..model.bodies import _add_mass_at, body_attachments_system, body_own_system, place_attachments
 from ..model.body_groups import body_unknowns, kept_rows, set_body_arms
+from ..model.body_layout import ADDED_N, ADDED_T, COB, COG, DAMPER, DRAG, DRAG_ROT, INERTIA, LIFT, MASS, SPRING
 from ..model.body_sea import WITH_BODY_SEA, sea_rates
 from ..model.forces.fluid import WITH_FLOW, flow_at, node_tangent
 from ..model.forces.gravity import WITH_GRAVITY
-from ..model.rotation import cross, matrix_of, rotate_back, turn
+from ..model.rotation import cross, matrix_of, rotate, rotate_back, turn
 
 BodyStage = namedtuple("BodyStage", ["base", "pose", "twist", "hat_r", "hat_phi", "hat_w", "r", "phi", "step",
                                      "work", "own", "inertia", "out", "keep", "where"])
@@ -191,6 +192,7 @@ def stage_rows(body, X, acc, beta, damp, t, p, groups, rhs):
     work, own, inertia, keep = body.work, body.own, body.inertia, body.keep
     k = keep.shape[0]
     first = body.where[1]
+    attached = bodies.links.shape[0]   # bodies.index[attached + b]: body b's first attachment
     norm = 0.0
     for b in range(body.r.shape[1]):
         pose, twist = body.pose, body.twist
@@ -205,20 +207,17 @@ def stage_rows(body, X, acc, beta, damp, t, p, groups, rhs):
                 own[i, j] = work[i, j]
             work[i, 6] = -beta * (s - damp * work[i, 6])
         # the plain attachment masses the band holds; the turning forces; the centripetal and drag rates
-        m = bodies.mass[b]
-        c0, c1, c2 = r[0] * bodies.cog[0, b] + r[1] * bodies.cog[1, b] + r[2] * bodies.cog[2, b], \
-            r[3] * bodies.cog[0, b] + r[4] * bodies.cog[1, b] + r[5] * bodies.cog[2, b], \
-            r[6] * bodies.cog[0, b] + r[7] * bodies.cog[1, b] + r[8] * bodies.cog[2, b]
+        record = bodies.table[b]
+        m = record[MASS]
+        c0, c1, c2 = rotate(r, record[COG], record[COG + 1], record[COG + 2])
         _add_turning_force(own, 0.0, -m * g, 0.0, c0, c1, c2, beta * damp)
         _add_centripetal(own, m, 0.0, 0.0, m, 0.0, m, c0, c1, c2, w0, w1, w2, damp)
-        lift = bodies.lift[b]
+        lift = record[LIFT]
         if lift != 0.0:
-            k0 = r[0] * bodies.cob[0, b] + r[1] * bodies.cob[1, b] + r[2] * bodies.cob[2, b]
-            k1 = r[3] * bodies.cob[0, b] + r[4] * bodies.cob[1, b] + r[5] * bodies.cob[2, b]
-            k2 = r[6] * bodies.cob[0, b] + r[7] * bodies.cob[1, b] + r[8] * bodies.cob[2, b]
+            k0, k1, k2 = rotate(r, record[COB], record[COB + 1], record[COB + 2])
             _add_turning_force(own, 0.0, lift, 0.0, k0, k1, k2, beta * damp)
-        for c in range(bodies.start[b], bodies.start[b + 1]):
-            i = bodies.nodes[c]
+        for c in range(bodies.index[attached + b], bodies.index[attached + b + 1]):
+            i = bodies.index[c]
             mi = 1.0 / p.inv_mass[i]
             p0 = groups.arm[0, body.where[0] + c]
             p1 = groups.arm[1, body.where[0] + c]
@@ -226,7 +225,7 @@ def stage_rows(body, X, acc, beta, damp, t, p, groups, rhs):
             _add_mass_at(own, -mi, 0.0, 0.0, -mi, 0.0, -mi, p0, p1, p2)
             a2 = acc[2, i] if dim == 3 else 0.0
             _add_turning_force(own, mi * acc[0, i], mi * acc[1, i], mi * a2, p0, p1, p2, beta * damp)
-            a_n, a_t = bodies.node_added[0, c], bodies.node_added[1, c]
+            a_n, a_t = bodies.links[c, ADDED_N], bodies.links[c, ADDED_T]
             q0, q1, q2 = node_tangent(X, i, p.neighbours)
             extra = a_t - a_n
             _add_centripetal(own, mi + a_n + extra * q0 * q0, extra * q0 * q1, extra * q0 * q2,
@@ -238,7 +237,7 @@ def stage_rows(body, X, acc, beta, damp, t, p, groups, rhs):
                 s = 0.0
                 for a in range(3):
                     for c in range(3):
-                        s += r[3 * i + a] * bodies.inertia[a, c, b] * r[3 * j + c]
+                        s += r[3 * i + a] * record[INERTIA + 3 * a + c] * r[3 * j + c]
                 inertia[i, j] = s
         i0 = inertia[0, 0] * w0 + inertia[0, 1] * w1 + inertia[0, 2] * w2
         i1 = inertia[1, 0] * w0 + inertia[1, 1] * w1 + inertia[1, 2] * w2
@@ -259,14 +258,14 @@ def stage_rows(body, X, acc, beta, damp, t, p, groups, rhs):
             heave, wet, dry, u0, u1, u2, air0, air1, air2 = sea_rates(p.flow, bodies, pose, twist, b, t, r)
             own[1, 1] += beta * damp * heave
             ub = rotate_back(r, u0, u1, u2)
-            _add_drag_rate(own, 0, r, bodies.drag[0, b], bodies.drag[1, b], bodies.drag[2, b], ub[0], ub[1], ub[2],
+            _add_drag_rate(own, 0, r, record[DRAG], record[DRAG + 1], record[DRAG + 2], ub[0], ub[1], ub[2],
                            damp * wet)
             ub = rotate_back(r, air0, air1, air2)
-            _add_drag_rate(own, 0, r, bodies.drag[0, b], bodies.drag[1, b], bodies.drag[2, b], ub[0], ub[1], ub[2],
+            _add_drag_rate(own, 0, r, record[DRAG], record[DRAG + 1], record[DRAG + 2], ub[0], ub[1], ub[2],
                            damp * dry)
             wb = rotate_back(r, w0, w1, w2)
-            _add_drag_rate(own, 3, r, bodies.drag_rot[0, b], bodies.drag_rot[1, b], bodies.drag_rot[2, b], wb[0],
-                           wb[1], wb[2], damp * (wet + dry))
+            _add_drag_rate(own, 3, r, record[DRAG_ROT], record[DRAG_ROT + 1], record[DRAG_ROT + 2], wb[0], wb[1],
+                           wb[2], damp * (wet + dry))
         else:
             u0, u1, u2 = -twist[0, b], -twist[1, b], -twist[2, b]
             if WITH_FLOW:
@@ -275,23 +274,22 @@ def stage_rows(body, X, acc, beta, damp, t, p, groups, rhs):
                 u1 += U1
                 u2 += U2
             ub = rotate_back(r, u0, u1, u2)
-            _add_drag_rate(own, 0, r, bodies.drag[0, b], bodies.drag[1, b], bodies.drag[2, b], ub[0], ub[1], ub[2],
-                           damp)
+            _add_drag_rate(own, 0, r, record[DRAG], record[DRAG + 1], record[DRAG + 2], ub[0], ub[1], ub[2], damp)
             wb = rotate_back(r, w0, w1, w2)
-            _add_drag_rate(own, 3, r, bodies.drag_rot[0, b], bodies.drag_rot[1, b], bodies.drag_rot[2, b], wb[0],
-                           wb[1], wb[2], damp)
+            _add_drag_rate(own, 3, r, record[DRAG_ROT], record[DRAG_ROT + 1], record[DRAG_ROT + 2], wb[0], wb[1],
+                           wb[2], damp)
         # the linear spring and damper on the reference point: beta^2 k + beta c on its translation
         for a in range(3):
-            if bodies.spring[a, b] != 0.0 or bodies.damper[a, b] != 0.0:
-                own[a, a] += beta * damp * bodies.spring[a, b] + damp * bodies.damper[a, b]
+            if record[SPRING + a] != 0.0 or record[DAMPER + a] != 0.0:
+                own[a, a] += beta * damp * record[SPRING + a] + damp * record[DAMPER + a]
         at = first + b * k
         for a in range(k):
             groups.own_rhs[at + a] = work[keep[a], 6]
             norm += work[keep[a], 6] * work[keep[a], 6]
             for c in range(k):
                 groups.own[at + a, at + c] = own[keep[a], keep[c]]
-        for c in range(bodies.start[b], bodies.start[b + 1]):
-            i = bodies.nodes[c]
+        for c in range(bodies.index[attached + b], bodies.index[attached + b + 1]):
+            i = bodies.index[c]
             for d in range(dim):
                 rhs[i * dim + d] = 0.0
     return norm

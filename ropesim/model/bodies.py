@@ -42,37 +42,35 @@ The power of the fluid's forces on the body (drag, and the added mass's inertial
 work, as for a node. Gravity and buoyancy are conservative: the body's mechanical energy is
 1/2 m |v + w x c|^2 + 1/2 w . I w + m g (r + c)_y - rho V g (r + R c_B)_y (:func:`body_energy`).
 
-Parameters, :class:`Bodies` (B free bodies, K attachments): per body mass (B,) [kg], centre of gravity ``cog``
-(3, B) and of buoyancy ``cob`` (3, B) in the body frame [m], ``inertia`` (3, 3, B) about the centre of gravity in
-body axes [kg m^2], ``lift`` (B,) rho V g [N], ``drag`` (3, B) 1/2 rho CdA [kg/m], ``drag_rot`` (3, B) 1/2 rho Cd_r
-[kg m^2], ``added`` (3, B) [kg] and ``added_rot`` (3, B) [kg m^2] on the body axes; body b's attachments are
-``nodes[start[b]:start[b + 1]]`` at arms ``arm`` (3, K) [m], with their line added-mass coefficients
-``node_added`` (2, K) [kg] (a_n, a_t: the per-node added-mass pass leaves them to this one); ``mass0`` (B, 6, 6)
-the constant part of each body's mass matrix in body axes and ``factor`` (B, 6, 6) its L D L^T, on the kept rows
-``rows`` (6 in 3-D, x, y and the turn about z in 2-D: the leading n x n of each), ``varies`` (B,) whether a body
-has attachments with a_t != a_n; ``attached_mass`` (K,) [kg] the attachments' masses; scratch: ``tangent`` (4, K)
-the chords along their lines in body axes d (the tangent q = d / |d|) and (a_t - a_n) / |d|^2, ``work`` (B, 6, 7)
-each body's solve (a varying body's factor kept there for the next call at the same positions).
+Parameters, :class:`~ropesim.model.body_layout.Bodies` (B free bodies, K attachments), packed into four arrays so
+that a compiled call carries few (:mod:`ropesim.model.body_layout` names the columns): per body a record in
+``table`` (B, BODY_COLUMNS) with its mass [kg], rho V g [N], centre of gravity and of buoyancy in the body frame
+[m], 1/2 rho CdA [kg/m], 1/2 rho Cd_r [kg m^2], added mass [kg] and inertia [kg m^2] on the body axes, its spring,
+damper and rest point, and its inertia (3 x 3) about the centre of gravity in body axes [kg m^2]; per attachment a
+record in ``links`` (K, LINK_COLUMNS) with its arm (body frame) [m], its line's added-mass coefficients a_n, a_t
+[kg] (the per-node added-mass pass leaves them to this one), its node's mass [kg] and, as scratch, its chord d
+along its line in body axes (the tangent q = d / |d|) and (a_t - a_n) / |d|^2; ``matrices`` (B, 3, 6, 7) each
+body's constant mass matrix in body axes, its L D L^T, and its solve's scratch, on the kept rows (6 in 3-D; x, y
+and the turn about z in 2-D); ``index`` the attachments' nodes, then each body's first attachment. A body
+*varies* when its attachments have a_t != a_n.
 """
 
 from __future__ import annotations
 
 import math
-from collections import namedtuple
 
 import numpy as np
 
 from . import jit
+from .body_layout import (ADDED, ADDED_N, ADDED_ROT, ADDED_T, ARM, BODY_COLUMNS, CHORD, CHORD_SCALE, COB, COG,
+                          CONSTANT, DAMPER, DRAG, DRAG_ROT, FACTOR, INERTIA, LIFT, LINK_COLUMNS, MASS, NODE_MASS,
+                          REST, SCRATCH, SPRING, VARIES, Bodies)
 from .body_sea import WITH_BODY_SEA, sea_loads
 from .forces.fluid import WITH_FLOW, flow_at, node_tangent
 from ..scene.schema import STILL_KINDS
 from .rotation import cross, matrix_of, quaternion_from_angles, rotate, rotate_back, turn
 
 WITH_BODIES = jit.Switch("bodies", "free rigid bodies")
-
-Bodies = namedtuple("Bodies", ["mass", "cog", "inertia", "lift", "cob", "drag", "drag_rot", "added", "added_rot",
-                               "spring", "damper", "rest", "start", "nodes", "arm", "node_added", "mass0", "factor",
-                               "varies", "rows", "attached_mass", "tangent", "work", "sea"], defaults=(None,))
 
 POSE, TWIST = 7, 6   # rows of the pose (r, q) and twist (v, w) arrays
 STATE_ROWS = POSE + TWIST   # a saved frame's rows per body
@@ -141,48 +139,46 @@ def bodies_bundle(scene, ends: dict[str, list[int]], added: np.ndarray, node_mas
     rho = scene.fluid.density if scene.fluid is not None else 0.0
     g = scene.gravity.g if scene.gravity is not None else 0.0
     count = len(bodies)
-    out = {name: np.zeros((3, count)) for name in ("cog", "cob", "drag", "drag_rot", "added", "added_rot", "spring",
-                                                   "damper", "rest")}
-    mass, lift, inertia = np.zeros(count), np.zeros(count), np.zeros((3, 3, count))
-    start, nodes, arms = np.zeros(count + 1, dtype=np.int64), [], []
     on_body = attachments(scene, ends)
+    table = np.zeros((count, BODY_COLUMNS))
+    nodes, arms, start = [], [], [0]
     for b, body in enumerate(bodies):
-        mass[b] = body.mass
-        lift[b] = rho * body.volume * g
-        inertia[:, :, b] = inertia_tensor(body.inertia, dim)
-        out["cog"][:, b] = vector3(body.center_of_gravity, dim)
-        out["cob"][:, b] = vector3(body.center_of_buoyancy, dim)
-        out["drag"][:, b] = 0.5 * rho * vector3(body.cd_area, dim)
-        out["drag_rot"][:, b] = 0.5 * rho * turns3(body.cd_rotation, dim)
-        out["added"][:, b] = vector3(body.added_mass, dim)
-        out["added_rot"][:, b] = turns3(body.added_inertia, dim)
-        out["spring"][:, b] = vector3(body.stiffness or (0.0,) * dim, dim)
-        out["damper"][:, b] = vector3(body.damping or (0.0,) * dim, dim)
-        out["rest"][:, b] = vector3(body.position, dim)
+        record = table[b]
+        record[MASS] = body.mass
+        record[LIFT] = rho * body.volume * g
+        record[INERTIA:INERTIA + 9] = inertia_tensor(body.inertia, dim).ravel()
+        for column, values in ((COG, vector3(body.center_of_gravity, dim)),
+                               (COB, vector3(body.center_of_buoyancy, dim)),
+                               (DRAG, 0.5 * rho * vector3(body.cd_area, dim)),
+                               (DRAG_ROT, 0.5 * rho * turns3(body.cd_rotation, dim)),
+                               (ADDED, vector3(body.added_mass, dim)), (ADDED_ROT, turns3(body.added_inertia, dim)),
+                               (SPRING, vector3(body.stiffness or (0.0,) * dim, dim)),
+                               (DAMPER, vector3(body.damping or (0.0,) * dim, dim)), (REST, vector3(body.position, dim))):
+            record[column:column + 3] = values
         for node, arm in on_body[body.id]:
             nodes.append(node)
             arms.append(arm)
-        start[b + 1] = len(nodes)
+        start.append(len(nodes))
     node_index = np.array(nodes, dtype=np.int64)
-    node_added = np.zeros((2, len(nodes)))
+    links = np.zeros((len(nodes), LINK_COLUMNS))
+    if arms:
+        links[:, ARM:ARM + 3] = arms
     if added.size and len(nodes):
-        node_added[:] = added[:, node_index]
+        links[:, ADDED_N:ADDED_N + 2] = added[:, node_index].T
         added[:, node_index] = 0.0
-    arm = np.array(arms, dtype=float).T.copy() if arms else np.zeros((3, 0))
+    links[:, NODE_MASS] = 1.0 / (1.0 / node_mass[node_index])   # as the compiled code has m from 1 / m
+    bundle = Bodies(table, links, np.zeros((count, 3, 6, 7)), np.concatenate([node_index, start]).astype(np.int64))
     rows = np.arange(6) if dim == 3 else np.array([0, 1, 5])
-    mass0, factor, varies = np.zeros((count, 6, 6)), np.zeros((count, 6, 6)), np.zeros(count, dtype=np.int64)
+    n = len(rows)
     for b in range(count):
-        own = constant_mass(mass[b], out["cog"][:, b], inertia[:, :, b], out["added"][:, b], out["added_rot"][:, b],
-                            node_mass[node_index[start[b]:start[b + 1]]] + node_added[0, start[b]:start[b + 1]],
-                            arm[:, start[b]:start[b + 1]])
-        n = len(rows)
-        mass0[b, :n, :n] = own[np.ix_(rows, rows)]
-        factor[b, :n, :n] = ldl_factor(mass0[b, :n, :n])
-        varies[b] = np.any(node_added[1, start[b]:start[b + 1]] != node_added[0, start[b]:start[b + 1]])
-    return Bodies(mass, out["cog"], inertia, lift, out["cob"], out["drag"], out["drag_rot"], out["added"],
-                  out["added_rot"], out["spring"], out["damper"], out["rest"], start, node_index, arm, node_added,
-                  mass0, factor, varies, rows.astype(np.int64), 1.0 / (1.0 / node_mass[node_index]),
-                  np.zeros((4, len(nodes))), np.zeros((count, 6, 7)))
+        k0, k1 = start[b], start[b + 1]
+        own = constant_mass(table[b, MASS], bundle.cog[:, b], bundle.inertia[:, :, b], bundle.added[:, b],
+                            bundle.added_rot[:, b], node_mass[node_index[k0:k1]] + links[k0:k1, ADDED_N],
+                            links[k0:k1, ARM:ARM + 3].T)
+        bundle.matrices[b, CONSTANT, :n, :n] = own[np.ix_(rows, rows)]
+        bundle.matrices[b, FACTOR, :n, :n] = ldl_factor(own[np.ix_(rows, rows)])
+        table[b, VARIES] = float(np.any(links[k0:k1, ADDED_T] != links[k0:k1, ADDED_N]))
+    return bundle
 
 
 def mass_at(mass: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -251,13 +247,14 @@ def body_energy_numpy(bundle: Bodies, pose: np.ndarray, twist: np.ndarray, g: fl
 def place_attachments(x, v, bodies, pose, twist):
     """Put every attachment node where its body holds it: x_i = r + R s_i, v_i = v + w x R s_i."""
     dim = x.shape[0]
-    start, nodes, arm = bodies.start, bodies.nodes, bodies.arm
-    for b in range(start.shape[0] - 1):
+    links, index = bodies.links, bodies.index
+    first = links.shape[0]   # index[first + b]: body b's first attachment
+    for b in range(pose.shape[1]):
         r = matrix_of(pose[3:7], b)
         w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
-        for k in range(start[b], start[b + 1]):
-            i = nodes[k]
-            p0, p1, p2 = rotate(r, arm[0, k], arm[1, k], arm[2, k])
+        for k in range(index[first + b], index[first + b + 1]):
+            i = index[k]
+            p0, p1, p2 = rotate(r, links[k, ARM], links[k, ARM + 1], links[k, ARM + 2])
             e0, e1, e2 = cross(w0, w1, w2, p0, p1, p2)
             x[0, i] = pose[0, b] + p0
             x[1, i] = pose[1, b] + p1
@@ -332,18 +329,18 @@ def _ldl_factor(a, n):
 
 
 @jit.kernel(inline="always")
-def _varying_mass(work, mass0, b, n, tangent, arm, k0, k1):
-    """Body b's mass matrix in its axes into ``work``'s lower triangle: the constant part ``mass0[b]`` plus each
-    attachment k0 <= k < k1's rank-one term c d d^T at its arm s, u = (d, s x d) on the n kept rows (``tangent``:
+def _varying_mass(work, constant, n, links, k0, k1):
+    """A body's mass matrix in its axes into ``work``'s lower triangle: its constant part ``constant`` plus each
+    attachment k0 <= k < k1's rank-one term c d d^T at its arm s, u = (d, s x d) on the n kept rows (``links``:
     the chords d and the factors c)."""
     for i in range(n):
         for j in range(i + 1):
-            work[i, j] = mass0[b, i, j]
+            work[i, j] = constant[i, j]
     for k in range(k0, k1):
-        c = tangent[3, k]
+        c = links[k, CHORD_SCALE]
         if c != 0.0:
-            d0, d1, d2 = tangent[0, k], tangent[1, k], tangent[2, k]
-            t0, t1, t2 = cross(arm[0, k], arm[1, k], arm[2, k], d0, d1, d2)
+            d0, d1, d2 = links[k, CHORD], links[k, CHORD + 1], links[k, CHORD + 2]
+            t0, t1, t2 = cross(links[k, ARM], links[k, ARM + 1], links[k, ARM + 2], d0, d1, d2)
             work[0, 6], work[1, 6] = d0, d1
             if n == 3:
                 work[2, 6] = t2
@@ -378,26 +375,26 @@ def own_load(gravity, flow, bodies, pose, twist, b, t, r):
     weight and centripetal force at its centre of gravity, the gyroscopic moment -w x (I w), its buoyancy at its
     centre of buoyancy, its drag and rotational drag, its linear spring and damper (see the module doc); and the
     power [W] of the drag and the damper, as (f0, f1, f2, m0, m1, m2, power). ``r``: R's nine entries."""
+    body = bodies.table[b]
     wb0, wb1, wb2 = rotate_back(r, twist[3, b], twist[4, b], twist[5, b])
     vb0, vb1, vb2 = rotate_back(r, twist[0, b], twist[1, b], twist[2, b])
     up0, up1, up2 = r[3], r[4], r[5]   # the world's up, R^T y, in body axes
-    m = bodies.mass[b]
-    c0, c1, c2 = bodies.cog[0, b], bodies.cog[1, b], bodies.cog[2, b]
+    m = body[MASS]
+    c0, c1, c2 = body[COG], body[COG + 1], body[COG + 2]
     e0, e1, e2 = cross(wb0, wb1, wb2, c0, c1, c2)
     n0, n1, n2 = cross(wb0, wb1, wb2, e0, e1, e2)   # w x (w x c)
     mg = m * gravity
     f0, f1, f2 = -m * n0 - mg * up0, -m * n1 - mg * up1, -m * n2 - mg * up2
-    inertia = bodies.inertia
-    j0 = inertia[0, 0, b] * wb0 + inertia[0, 1, b] * wb1 + inertia[0, 2, b] * wb2   # I_b w
-    j1 = inertia[1, 0, b] * wb0 + inertia[1, 1, b] * wb1 + inertia[1, 2, b] * wb2
-    j2 = inertia[2, 0, b] * wb0 + inertia[2, 1, b] * wb1 + inertia[2, 2, b] * wb2
+    j0 = body[INERTIA] * wb0 + body[INERTIA + 1] * wb1 + body[INERTIA + 2] * wb2   # I_b w
+    j1 = body[INERTIA + 3] * wb0 + body[INERTIA + 4] * wb1 + body[INERTIA + 5] * wb2
+    j2 = body[INERTIA + 6] * wb0 + body[INERTIA + 7] * wb1 + body[INERTIA + 8] * wb2
     g0, g1, g2 = cross(wb0, wb1, wb2, j0, j1, j2)
     m0, m1, m2 = cross(c0, c1, c2, f0, f1, f2)
     m0, m1, m2 = m0 - g0, m1 - g1, m2 - g2
-    lift = bodies.lift[b]
+    lift = body[LIFT]
     if lift != 0.0:
         l0, l1, l2 = lift * up0, lift * up1, lift * up2
-        k0, k1, k2 = cross(bodies.cob[0, b], bodies.cob[1, b], bodies.cob[2, b], l0, l1, l2)
+        k0, k1, k2 = cross(body[COB], body[COB + 1], body[COB + 2], l0, l1, l2)
         f0, f1, f2 = f0 + l0, f1 + l1, f2 + l2
         m0, m1, m2 = m0 + k0, m1 + k1, m2 + k2
     if WITH_BODY_SEA:   # under a free surface: water and air, the lost buoyancy, the water's inertia
@@ -414,19 +411,19 @@ def own_load(gravity, flow, bodies, pose, twist, b, t, r):
         speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
         spin = math.sqrt(wb0 * wb0 + wb1 * wb1 + wb2 * wb2)
         ub0, ub1, ub2 = rotate_back(r, u0, u1, u2)
-        d0, d1, d2 = bodies.drag[0, b] * speed * ub0, bodies.drag[1, b] * speed * ub1, bodies.drag[2, b] * speed * ub2
-        s0 = -bodies.drag_rot[0, b] * spin * wb0
-        s1 = -bodies.drag_rot[1, b] * spin * wb1
-        s2 = -bodies.drag_rot[2, b] * spin * wb2
+        d0, d1, d2 = body[DRAG] * speed * ub0, body[DRAG + 1] * speed * ub1, body[DRAG + 2] * speed * ub2
+        s0 = -body[DRAG_ROT] * spin * wb0
+        s1 = -body[DRAG_ROT + 1] * spin * wb1
+        s2 = -body[DRAG_ROT + 2] * spin * wb2
         power = d0 * vb0 + d1 * vb1 + d2 * vb2 + s0 * wb0 + s1 * wb1 + s2 * wb2
         f0, f1, f2, m0, m1, m2 = f0 + d0, f1 + d1, f2 + d2, m0 + s0, m1 + s1, m2 + s2
     # the linear spring and damper on the reference point (world axes; no moment about it); the damper's power is
     # the fluid's
     h0, h1, h2 = 0.0, 0.0, 0.0
     for k in range(3):
-        if bodies.spring[k, b] != 0.0 or bodies.damper[k, b] != 0.0:
-            damping = bodies.damper[k, b] * twist[k, b]
-            pull = -(bodies.spring[k, b] * (pose[k, b] - bodies.rest[k, b]) + damping)
+        if body[SPRING + k] != 0.0 or body[DAMPER + k] != 0.0:
+            damping = body[DAMPER + k] * twist[k, b]
+            pull = -(body[SPRING + k] * (pose[k, b] - body[REST + k]) + damping)
             power -= damping * twist[k, b]
             if k == 0:
                 h0 = pull
@@ -445,22 +442,23 @@ def body_own_system(work, gravity, flow, bodies, pose, twist, b, t, power):
     """Body b's own part of its Newton-Euler equations (see the module doc) into ``work`` (6, 7), zeroed first, in
     world axes: its mass at its centre of gravity, inertia and added mass (the matrix), its own force and moment
     (:func:`own_load`, the right-hand side); returns ``power`` [W] plus the drag's and the damper's."""
+    body = bodies.table[b]
     r = matrix_of(pose[3:7], b)
     for i in range(6):
         for j in range(7):
             work[i, j] = 0.0
-    m = bodies.mass[b]
-    c0, c1, c2 = rotate(r, bodies.cog[0, b], bodies.cog[1, b], bodies.cog[2, b])
+    m = body[MASS]
+    c0, c1, c2 = rotate(r, body[COG], body[COG + 1], body[COG + 2])
     _add_mass_at(work, m, 0.0, 0.0, m, 0.0, m, c0, c1, c2)
     for i in range(3):   # R I_b R^T
         for j in range(3):
             s = 0.0
             for k in range(3):
                 for l in range(3):
-                    s += r[3 * i + k] * bodies.inertia[k, l, b] * r[3 * j + l]
+                    s += r[3 * i + k] * body[INERTIA + 3 * k + l] * r[3 * j + l]
             work[3 + i, 3 + j] += s
-    _add_rotated(work, 0, 0, r, bodies.added[0, b], bodies.added[1, b], bodies.added[2, b])
-    _add_rotated(work, 3, 3, r, bodies.added_rot[0, b], bodies.added_rot[1, b], bodies.added_rot[2, b])
+    _add_rotated(work, 0, 0, r, body[ADDED], body[ADDED + 1], body[ADDED + 2])
+    _add_rotated(work, 3, 3, r, body[ADDED_ROT], body[ADDED_ROT + 1], body[ADDED_ROT + 2])
     f0, f1, f2, m0, m1, m2, own = own_load(gravity, flow, bodies, pose, twist, b, t, r)
     work[0, 6], work[1, 6], work[2, 6] = rotate(r, f0, f1, f2)
     work[3, 6], work[4, 6], work[5, 6] = rotate(r, m0, m1, m2)
@@ -473,14 +471,15 @@ def body_attachments_system(work, x, acc, inv_mass, around, bodies, pose, twist,
     added mass at its arm, and its force m_i acc_i less its centripetal part (``acc`` holding each node's
     F_i / m_i)."""
     dim = x.shape[0]
-    start, nodes, arm, node_added = bodies.start, bodies.nodes, bodies.arm, bodies.node_added
+    links, index = bodies.links, bodies.index
+    first = links.shape[0]
     r = matrix_of(pose[3:7], b)
     w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
-    for k in range(start[b], start[b + 1]):
-        i = nodes[k]
-        p0, p1, p2 = rotate(r, arm[0, k], arm[1, k], arm[2, k])
+    for k in range(index[first + b], index[first + b + 1]):
+        i = index[k]
+        p0, p1, p2 = rotate(r, links[k, ARM], links[k, ARM + 1], links[k, ARM + 2])
         mi = 1.0 / inv_mass[i]
-        a_n, a_t = node_added[0, k], node_added[1, k]
+        a_n, a_t = links[k, ADDED_N], links[k, ADDED_T]
         q0, q1, q2 = node_tangent(x, i, around)
         extra = a_t - a_n   # m I + a_n (I - q q^T) + a_t q q^T
         m00 = mi + a_n + extra * q0 * q0
@@ -512,29 +511,32 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
 
     Solved in the body's axes, where its mass matrix is constant but for its attachments' added mass along their
     lines' tangents, (a_t - a_n) q q^T at each arm, a rank-one term u u^T with u = (q, s x q): the constant part
-    is factored once (``bodies.factor``, :func:`bodies_bundle`), and a body with such terms adds them to it and
-    factors its 6 x 6 (3 x 3 in 2-D) matrix per evaluation; with ``moved`` False (the nodes and the bodies' poses
-    where they were at the last call: the sub-stages of a velocity kick) it reuses that call's chords and factor.
-    The stiff integrator's Newton solve assembles the same equations in world axes (:func:`body_own_system`,
+    is factored once (:func:`bodies_bundle`), and a body with such terms adds them to it and factors its 6 x 6
+    (3 x 3 in 2-D) matrix per evaluation; with ``moved`` False (the nodes and the bodies' poses where they were at
+    the last call: the sub-stages of a velocity kick) it reuses that call's chords and factor. The stiff
+    integrator's Newton solve assembles the same equations in world axes (:func:`body_own_system`,
     :func:`body_attachments_system`)."""
     dim = x.shape[0]
-    tangent = bodies.tangent
-    start, nodes, arm, node_added = bodies.start, bodies.nodes, bodies.arm, bodies.node_added
-    n = bodies.rows.shape[0]
+    links, index = bodies.links, bodies.index
+    first = links.shape[0]   # index[first + b]: body b's first attachment
+    n = 6 if dim == 3 else 3
     power = 0.0
-    for b in range(start.shape[0] - 1):
+    for b in range(pose.shape[1]):
         r = matrix_of(pose[3:7], b)
         w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
         wb0, wb1, wb2 = rotate_back(r, w0, w1, w2)
-        work = bodies.work[b]
-        refactor = moved and bodies.varies[b] != 0
+        body = bodies.table[b]
+        work = bodies.matrices[b, SCRATCH]
+        varies = body[VARIES] != 0.0
+        k_first, k_end = index[first + b], index[first + b + 1]
         f0, f1, f2, m0, m1, m2, own = own_load(gravity, flow, bodies, pose, twist, b, t, r)
         power += own
-        for k in range(start[b], start[b + 1]):   # each attachment's force less its centripetal part
-            i = nodes[k]
-            s0, s1, s2 = arm[0, k], arm[1, k], arm[2, k]
-            mi = bodies.attached_mass[k]
-            a_n, a_t = node_added[0, k], node_added[1, k]
+        for k in range(k_first, k_end):   # each attachment's force less its centripetal part
+            link = links[k]
+            i = index[k]
+            s0, s1, s2 = link[ARM], link[ARM + 1], link[ARM + 2]
+            mi = link[NODE_MASS]
+            a_n, a_t = link[ADDED_N], link[ADDED_T]
             g0, g1, g2 = rotate_back(r, mi * acc[0, i], mi * acc[1, i], mi * acc[2, i] if dim == 3 else 0.0)
             e0, e1, e2 = cross(wb0, wb1, wb2, s0, s1, s2)
             n0, n1, n2 = cross(wb0, wb1, wb2, e0, e1, e2)   # w x (w x s)
@@ -547,22 +549,22 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
                                              x[2, hi] - x[2, lo] if dim == 3 else 0.0)
                     chord = d0 * d0 + d1 * d1 + d2 * d2
                     c = (a_t - a_n) / chord if chord > 0.0 else 0.0
-                    tangent[0, k], tangent[1, k], tangent[2, k], tangent[3, k] = d0, d1, d2, c
+                    link[CHORD], link[CHORD + 1], link[CHORD + 2], link[CHORD_SCALE] = d0, d1, d2, c
                 else:
-                    d0, d1, d2, c = tangent[0, k], tangent[1, k], tangent[2, k], tangent[3, k]
+                    d0, d1, d2, c = link[CHORD], link[CHORD + 1], link[CHORD + 2], link[CHORD_SCALE]
                 along = c * (d0 * n0 + d1 * n1 + d2 * n2)
                 g0, g1, g2 = g0 - along * d0, g1 - along * d1, g2 - along * d2
             h0, h1, h2 = cross(s0, s1, s2, g0, g1, g2)
             f0, f1, f2, m0, m1, m2 = f0 + g0, f1 + g1, f2 + g2, m0 + h0, m1 + h1, m2 + h2
-        if refactor:
-            _varying_mass(work, bodies.mass0, b, n, tangent, arm, start[b], start[b + 1])
+        if moved and varies:
+            _varying_mass(work, bodies.matrices[b, CONSTANT], n, links, k_first, k_end)
             _ldl_factor(work, n)
         work[0, 6], work[1, 6] = f0, f1   # the kept rows' right-hand side: x, y and the turn about z in 2-D
         if n == 3:
             work[2, 6] = m2
         else:
             work[2, 6], work[3, 6], work[4, 6], work[5, 6] = f2, m0, m1, m2
-        _ldl_solve(work if bodies.varies[b] != 0 else bodies.factor[b], n, work)
+        _ldl_solve(work if varies else bodies.matrices[b, FACTOR], n, work)
         if n == 3:   # 2-D: x, y and the turn about z
             ab0, ab1, ab2, alb0, alb1, alb2 = work[0, 6], work[1, 6], 0.0, 0.0, 0.0, work[2, 6]
         else:
@@ -571,12 +573,12 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
         out[3, b], out[4, b], out[5, b] = rotate(r, alb0, alb1, alb2)
         # the fluid's inertial force on the body's own added mass: -A_t a . v - A_r alpha . w
         vb0, vb1, vb2 = rotate_back(r, twist[0, b], twist[1, b], twist[2, b])
-        power -= bodies.added[0, b] * ab0 * vb0 + bodies.added[1, b] * ab1 * vb1 + bodies.added[2, b] * ab2 * vb2
-        power -= bodies.added_rot[0, b] * alb0 * wb0 + bodies.added_rot[1, b] * alb1 * wb1 + \
-            bodies.added_rot[2, b] * alb2 * wb2
-        for k in range(start[b], start[b + 1]):   # each attachment's acceleration a + alpha x s + w x (w x s)
-            i = nodes[k]
-            s0, s1, s2 = arm[0, k], arm[1, k], arm[2, k]
+        power -= body[ADDED] * ab0 * vb0 + body[ADDED + 1] * ab1 * vb1 + body[ADDED + 2] * ab2 * vb2
+        power -= body[ADDED_ROT] * alb0 * wb0 + body[ADDED_ROT + 1] * alb1 * wb1 + body[ADDED_ROT + 2] * alb2 * wb2
+        for k in range(k_first, k_end):   # each attachment's acceleration a + alpha x s + w x (w x s)
+            link = links[k]
+            i = index[k]
+            s0, s1, s2 = link[ARM], link[ARM + 1], link[ARM + 2]
             e0, e1, e2 = cross(wb0, wb1, wb2, s0, s1, s2)
             t0, t1, t2 = cross(alb0, alb1, alb2, s0, s1, s2)
             n0, n1, n2 = cross(wb0, wb1, wb2, e0, e1, e2)
@@ -586,12 +588,12 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
             acc[1, i] = k1
             if dim == 3:
                 acc[2, i] = k2
-            a_n, a_t = node_added[0, k], node_added[1, k]
+            a_n, a_t = link[ADDED_N], link[ADDED_T]
             if a_n != 0.0 or a_t != 0.0:   # the fluid's inertial force -A_i a_i on the node, at its velocity
                 h0, h1, h2 = a_n * kb0, a_n * kb1, a_n * kb2   # in body axes, with the chord kept above
                 if a_t != a_n:
-                    d0, d1, d2 = tangent[0, k], tangent[1, k], tangent[2, k]
-                    along = tangent[3, k] * (kb0 * d0 + kb1 * d1 + kb2 * d2)
+                    d0, d1, d2 = link[CHORD], link[CHORD + 1], link[CHORD + 2]
+                    along = link[CHORD_SCALE] * (kb0 * d0 + kb1 * d1 + kb2 * d2)
                     h0, h1, h2 = h0 + along * d0, h1 + along * d1, h2 + along * d2
                 u0, u1, u2 = rotate_back(r, v[0, i], v[1, i], v[2, i] if dim == 3 else 0.0)
                 power -= h0 * u0 + h1 * u1 + h2 * u2
@@ -603,23 +605,24 @@ def body_energy(bodies, pose, twist, gravity):
     """The free bodies' mechanical energy [J]: kinetic, gravitational and buoyancy (see the module doc)."""
     e = 0.0
     for b in range(pose.shape[1]):
+        body = bodies.table[b]
         r = matrix_of(pose[3:7], b)
         w0, w1, w2 = twist[3, b], twist[4, b], twist[5, b]
-        c0, c1, c2 = rotate(r, bodies.cog[0, b], bodies.cog[1, b], bodies.cog[2, b])
+        c0, c1, c2 = rotate(r, body[COG], body[COG + 1], body[COG + 2])
         e0, e1, e2 = cross(w0, w1, w2, c0, c1, c2)
         g0, g1, g2 = twist[0, b] + e0, twist[1, b] + e1, twist[2, b] + e2
         wb = rotate_back(r, w0, w1, w2)
         spin = 0.0   # w . I w = (R^T w) . I_b (R^T w)
         for k in range(3):
             for l in range(3):
-                spin += wb[k] * bodies.inertia[k, l, b] * wb[l]
-        m = bodies.mass[b]
-        k1 = rotate(r, bodies.cob[0, b], bodies.cob[1, b], bodies.cob[2, b])[1]
+                spin += wb[k] * body[INERTIA + 3 * k + l] * wb[l]
+        m = body[MASS]
+        k1 = rotate(r, body[COB], body[COB + 1], body[COB + 2])[1]
         e += 0.5 * m * (g0 * g0 + g1 * g1 + g2 * g2) + 0.5 * spin + m * gravity * (pose[1, b] + c1)
-        e -= bodies.lift[b] * (pose[1, b] + k1)
+        e -= body[LIFT] * (pose[1, b] + k1)
         for k in range(3):
-            stretch = pose[k, b] - bodies.rest[k, b]
-            e += 0.5 * bodies.spring[k, b] * stretch * stretch
+            stretch = pose[k, b] - body[REST + k]
+            e += 0.5 * body[SPRING + k] * stretch * stretch
     return e
 
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from . import jit
 from .bodies import body_own_system
+from .body_layout import ARM
 from .body_sea import heave_stiffness
 from .forces.gravity import WITH_GRAVITY
 from .rotation import matrix_of, rotate
@@ -40,11 +41,11 @@ def kept_rows(dim: int) -> np.ndarray:
 def set_body_arms(arm, first, bodies, pose):
     """Each body attachment's world arm rho_c = R s_c into the groups' ``arm`` (3, K), body members from
     ``first`` on (in the order of ``bodies.nodes``)."""
-    start = bodies.start
-    for b in range(start.shape[0] - 1):
+    links, index = bodies.links, bodies.index
+    for b in range(pose.shape[1]):
         r = matrix_of(pose[3:7], b)
-        for k in range(start[b], start[b + 1]):
-            p0, p1, p2 = rotate(r, bodies.arm[0, k], bodies.arm[1, k], bodies.arm[2, k])
+        for k in range(index[links.shape[0] + b], index[links.shape[0] + b + 1]):
+            p0, p1, p2 = rotate(r, links[k, ARM], links[k, ARM + 1], links[k, ARM + 2])
             arm[0, first + k] = p0
             arm[1, first + k] = p1
             arm[2, first + k] = p2

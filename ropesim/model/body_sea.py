@@ -51,6 +51,7 @@ from collections import namedtuple
 import numpy as np
 
 from . import jit
+from .body_layout import ADDED, COB, DRAG, DRAG_ROT, LIFT
 from .forces.fluid import WITH_FLOW, flow_at, flow_scaled
 from .forces.sea import AIR_RATIO, FRACTION_RULE, MOORDYN_RULE, WIND_X, WIND_Y, WIND_Z, WITH_WAVES
 from .ramp import ramp_rate
@@ -143,9 +144,10 @@ def water_at_body(flow, bodies, pose, b, t, r):
     if scalars[FRACTION_RULE] == MOORDYN_RULE:
         return 1.0, 0.0, u0, u1, u2, 0.0, 0.0, 0.0
     height = sea.rows[HEIGHT, b]
-    y_cob = py + r[3] * bodies.cob[0, b] + r[4] * bodies.cob[1, b] + r[5] * bodies.cob[2, b]
+    body = bodies.table[b]
+    y_cob = py + r[3] * body[COB] + r[4] * body[COB + 1] + r[5] * body[COB + 2]
     f = (scalars[LEVEL] + eta - y_cob) / height + 0.5
-    stiffness = bodies.lift[b] / height
+    stiffness = body[LIFT] / height
     if f <= 0.0:
         f, stiffness = 0.0, 0.0
     elif f >= 1.0:
@@ -162,14 +164,14 @@ def sea_loads(flow, bodies, pose, twist, b, t, r):
     f, _, u0, u1, u2, a0, a1, a2 = water_at_body(flow, bodies, pose, b, t, r)
     vb0, vb1, vb2 = rotate_back(r, twist[0, b], twist[1, b], twist[2, b])
     wb0, wb1, wb2 = rotate_back(r, twist[3, b], twist[4, b], twist[5, b])
-    c0, c1, c2 = bodies.cob[0, b], bodies.cob[1, b], bodies.cob[2, b]
-    lost = (1.0 - f) * bodies.lift[b]   # the buoyancy above the surface, taken away at the centre of buoyancy
+    body = bodies.table[b]
+    c0, c1, c2 = body[COB], body[COB + 1], body[COB + 2]
+    lost = (1.0 - f) * body[LIFT]   # the buoyancy above the surface, taken away at the centre of buoyancy
     f0, f1, f2 = -lost * r[3], -lost * r[4], -lost * r[5]
     m0, m1, m2 = cross(c0, c1, c2, f0, f1, f2)
     e0, e1, e2 = cross(wb0, wb1, wb2, c0, c1, c2)
     power = f0 * (vb0 + e0) + f1 * (vb1 + e1) + f2 * (vb2 + e2)
     ratio = scalars[AIR_RATIO]
-    drag = bodies.drag
     for part in range(2):   # the water's drag on the wet part, the air's on the dry part
         if part == 0:
             share, w0, w1, w2 = f, u0, u1, u2
@@ -178,21 +180,21 @@ def sea_loads(flow, bodies, pose, twist, b, t, r):
         if share > 0.0:
             ub0, ub1, ub2 = rotate_back(r, w0 - twist[0, b], w1 - twist[1, b], w2 - twist[2, b])
             speed = share * math.sqrt(ub0 * ub0 + ub1 * ub1 + ub2 * ub2)
-            d0, d1, d2 = drag[0, b] * speed * ub0, drag[1, b] * speed * ub1, drag[2, b] * speed * ub2
+            d0, d1, d2 = body[DRAG] * speed * ub0, body[DRAG + 1] * speed * ub1, body[DRAG + 2] * speed * ub2
             power += d0 * vb0 + d1 * vb1 + d2 * vb2
             f0, f1, f2 = f0 + d0, f1 + d1, f2 + d2
     spin = (f + ratio * (1.0 - f)) * math.sqrt(wb0 * wb0 + wb1 * wb1 + wb2 * wb2)
-    s0 = -bodies.drag_rot[0, b] * spin * wb0
-    s1 = -bodies.drag_rot[1, b] * spin * wb1
-    s2 = -bodies.drag_rot[2, b] * spin * wb2
+    s0 = -body[DRAG_ROT] * spin * wb0
+    s1 = -body[DRAG_ROT + 1] * spin * wb1
+    s2 = -body[DRAG_ROT + 2] * spin * wb2
     power += s0 * wb0 + s1 * wb1 + s2 * wb2
     m0, m1, m2 = m0 + s0, m1 + s1, m2 + s2
     if a0 != 0.0 or a1 != 0.0 or a2 != 0.0:   # Froude-Krylov and added mass: (f rho V + A) a_w
         ab0, ab1, ab2 = rotate_back(r, a0, a1, a2)
         fk = f * bodies.sea.rows[DISPLACED, b]
-        h0 = (fk + bodies.added[0, b]) * ab0
-        h1 = (fk + bodies.added[1, b]) * ab1
-        h2 = (fk + bodies.added[2, b]) * ab2
+        h0 = (fk + body[ADDED]) * ab0
+        h1 = (fk + body[ADDED + 1]) * ab1
+        h2 = (fk + body[ADDED + 2]) * ab2
         power += h0 * vb0 + h1 * vb1 + h2 * vb2
         f0, f1, f2 = f0 + h0, f1 + h1, f2 + h2
     return f0, f1, f2, m0, m1, m2, power
