@@ -33,7 +33,7 @@ those three degrees of freedom.
 The explicit methods solve these equations in the body's axes (:func:`move_bodies`), where the matrix is constant
 (its own mass, inertia and added mass, and each attachment's isotropic m_i + a_n at its fixed arm s_i) but for the
 attachments' added mass along their lines, (a_t - a_n) q q^T at s_i: a rank-one term u u^T, u = (q, s_i x q), q the
-line's tangent in body axes. The constant part is factored (L D L^T) once when the model is built; a body whose
+line's tangent in body axes. The constant part is inverted once when the model is built; a body whose
 lines have a_t != a_n adds its rank-one terms and factors its 6 x 6 per evaluation (a few hundred flops). Only the
 right-hand side is rotated in and the accelerations out. The stiff integrator's Newton solve and the static solver
 assemble the same equations in world axes (:func:`body_own_system`, :func:`body_attachments_system`).
@@ -50,7 +50,7 @@ damper and rest point, and its inertia (3 x 3) about the centre of gravity in bo
 record in ``links`` (K, LINK_COLUMNS) with its arm (body frame) [m], its line's added-mass coefficients a_n, a_t
 [kg] (the per-node added-mass pass leaves them to this one), its node's mass [kg] and, as scratch, its chord d
 along its line in body axes (the tangent q = d / |d|) and (a_t - a_n) / |d|^2; ``matrices`` (B, 3, 6, 7) each
-body's constant mass matrix in body axes, its L D L^T, and its solve's scratch, on the kept rows (6 in 3-D; x, y
+body's constant mass matrix in body axes, its inverse, and its solve's scratch, on the kept rows (6 in 3-D; x, y
 and the turn about z in 2-D); ``index`` the attachments' nodes, then each body's first attachment. A body
 *varies* when its attachments have a_t != a_n.
 """
@@ -63,7 +63,7 @@ import numpy as np
 
 from . import jit
 from .body_layout import (ADDED, ADDED_N, ADDED_ROT, ADDED_T, ARM, BODY_COLUMNS, CHORD, CHORD_SCALE, COB, COG,
-                          CONSTANT, DAMPER, DRAG, DRAG_ROT, FACTOR, INERTIA, LIFT, LINK_COLUMNS, MASS, NODE_MASS,
+                          CONSTANT, DAMPER, DRAG, DRAG_ROT, INERTIA, INVERSE, LIFT, LINK_COLUMNS, MASS, NODE_MASS,
                           REST, SCRATCH, SPRING, VARIES, Bodies)
 from .body_sea import WITH_BODY_SEA, sea_loads
 from .forces.fluid import WITH_FLOW, flow_at, node_tangent
@@ -176,7 +176,7 @@ def bodies_bundle(scene, ends: dict[str, list[int]], added: np.ndarray, node_mas
                             bundle.added_rot[:, b], node_mass[node_index[k0:k1]] + links[k0:k1, ADDED_N],
                             links[k0:k1, ARM:ARM + 3].T)
         bundle.matrices[b, CONSTANT, :n, :n] = own[np.ix_(rows, rows)]
-        bundle.matrices[b, FACTOR, :n, :n] = ldl_factor(own[np.ix_(rows, rows)])
+        bundle.matrices[b, INVERSE, :n, :n] = np.linalg.inv(own[np.ix_(rows, rows)])
         table[b, VARIES] = float(np.any(links[k0:k1, ADDED_T] != links[k0:k1, ADDED_N]))
     return bundle
 
@@ -199,16 +199,6 @@ def constant_mass(m, cog, inertia, added, added_rot, masses, arms) -> np.ndarray
     for mk, arm in zip(masses, arms.T):
         out += mass_at(mk * np.eye(3), arm)
     return out
-
-
-def ldl_factor(a: np.ndarray) -> np.ndarray:
-    """A = L D L^T of a symmetric positive definite a (n, n), as :func:`_ldl_factor` computes it compiled: L's
-    strict lower part, D on the diagonal (the upper part left as it was)."""
-    f = np.array(a, dtype=float)
-    for j in range(len(f)):
-        f[j, j] -= np.sum(f[j, :j] ** 2 * np.diag(f)[:j])
-        f[j + 1:, j] = (f[j + 1:, j] - f[j + 1:, :j] @ (f[j, :j] * np.diag(f)[:j])) / f[j, j]
-    return f
 
 
 def no_bodies() -> None:
@@ -314,7 +304,7 @@ def _add_rotated(work, row, col, r, d0, d1, d2):
 @jit.kernel(inline="always")
 def _ldl_factor(a, n):
     """A = L D L^T in place in a (n, n) symmetric positive definite matrix (its lower triangle read): L's strict
-    lower part and D on the diagonal (:func:`ldl_factor`)."""
+    lower part and D on the diagonal."""
     for j in range(n):
         d = a[j, j]
         for k in range(j):
@@ -367,6 +357,17 @@ def _ldl_solve(f, n, work):
         for k in range(i + 1, n):
             s -= f[k, i] * work[k, 6]
         work[i, 6] = s
+
+
+@jit.kernel(inline="always")
+def _times_inverse(inverse, n, work):
+    """work[:n, 0] = inverse work[:n, 6]: a body's constant mass matrix's inverse (n, n) applied to its right-hand
+    side (n independent dot products, where the L D L^T's triangular solves are two chains of dependent steps)."""
+    for i in range(n):
+        s = 0.0
+        for j in range(n):
+            s += inverse[i, j] * work[j, 6]
+        work[i, 0] = s
 
 
 @jit.kernel(inline="always")
@@ -511,7 +512,7 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
 
     Solved in the body's axes, where its mass matrix is constant but for its attachments' added mass along their
     lines' tangents, (a_t - a_n) q q^T at each arm, a rank-one term u u^T with u = (q, s x q): the constant part
-    is factored once (:func:`bodies_bundle`), and a body with such terms adds them to it and factors its 6 x 6
+    is inverted once (:func:`bodies_bundle`), and a body with such terms adds them to it and factors its 6 x 6
     (3 x 3 in 2-D) matrix per evaluation; with ``moved`` False (the nodes and the bodies' poses where they were at
     the last call: the sub-stages of a velocity kick) it reuses that call's chords and factor. The stiff
     integrator's Newton solve assembles the same equations in world axes (:func:`body_own_system`,
@@ -564,11 +565,17 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
             work[2, 6] = m2
         else:
             work[2, 6], work[3, 6], work[4, 6], work[5, 6] = f2, m0, m1, m2
-        _ldl_solve(work if varies else bodies.matrices[b, FACTOR], n, work)
+        if varies:
+            _ldl_solve(work, n, work)
+            at = 6
+        else:   # the constant matrix's inverse times the right-hand side, into the unused first column
+            _times_inverse(bodies.matrices[b, INVERSE], n, work)
+            at = 0
         if n == 3:   # 2-D: x, y and the turn about z
-            ab0, ab1, ab2, alb0, alb1, alb2 = work[0, 6], work[1, 6], 0.0, 0.0, 0.0, work[2, 6]
+            ab0, ab1, ab2, alb0, alb1, alb2 = work[0, at], work[1, at], 0.0, 0.0, 0.0, work[2, at]
         else:
-            ab0, ab1, ab2, alb0, alb1, alb2 = work[0, 6], work[1, 6], work[2, 6], work[3, 6], work[4, 6], work[5, 6]
+            ab0, ab1, ab2, alb0, alb1, alb2 = work[0, at], work[1, at], work[2, at], work[3, at], work[4, at], \
+                work[5, at]
         out[0, b], out[1, b], out[2, b] = rotate(r, ab0, ab1, ab2)
         out[3, b], out[4, b], out[5, b] = rotate(r, alb0, alb1, alb2)
         # the fluid's inertial force on the body's own added mass: -A_t a . v - A_r alpha . w

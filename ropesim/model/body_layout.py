@@ -27,10 +27,9 @@ BODY_COLUMNS = 39
 ARM, ADDED_N, ADDED_T, NODE_MASS, CHORD, CHORD_SCALE = 0, 3, 4, 5, 6, 9
 LINK_COLUMNS = 10
 # Each body's matrices, Bodies.matrices (B, 3, 6, 7): the constant part of its mass matrix in body axes, its
-# L D L^T, and the solve's scratch (a varying body's L D L^T kept there between calls); each on the
-# kept rows (the leading n x n: 6 in 3-D, x, y and the turn about z in 2-D), the scratch's last column the
-# right-hand side.
-CONSTANT, FACTOR, SCRATCH = range(3)
+# inverse, and the solve's scratch (a varying body's L D L^T kept there between calls); each on the kept rows
+# (the leading n x n: 6 in 3-D, x, y and the turn about z in 2-D), the scratch's last column the right-hand side.
+CONSTANT, INVERSE, SCRATCH = range(3)
 
 _VIEWS = {   # the former one-array-per-parameter names, as views of the packed arrays (NumPy code and tests)
     "mass": ("table", MASS, 0), "lift": ("table", LIFT, 0), "varies": ("table", VARIES, 0),
