@@ -153,7 +153,8 @@ def bodies_bundle(scene, ends: dict[str, list[int]], added: np.ndarray, node_mas
                                (DRAG_ROT, 0.5 * rho * turns3(body.cd_rotation, dim)),
                                (ADDED, vector3(body.added_mass, dim)), (ADDED_ROT, turns3(body.added_inertia, dim)),
                                (SPRING, vector3(body.stiffness or (0.0,) * dim, dim)),
-                               (DAMPER, vector3(body.damping or (0.0,) * dim, dim)), (REST, vector3(body.position, dim))):
+                               (DAMPER, vector3(body.damping or (0.0,) * dim, dim)),
+                               (REST, vector3(body.position, dim))):
             record[column:column + 3] = values
         for node, arm in on_body[body.id]:
             nodes.append(node)
