@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import jit
 from .bodies import body_frames, body_shapes
 from .forces.fluid import flow_at
 from .forces.springs import segment_forces, segment_strains
 from .motion import Held, place_moving
 from .sea_frames import sea_frames, sea_shapes
-from . import jit
 from .terms import WITH_MOTION, accelerations
 
 
