@@ -74,7 +74,8 @@ def main() -> int:
     nw, p = it.newton, it.model.params
     parts = {}
     for name, call in (
-            ("force evaluation + residual", lambda: k(G.residual)(w, nw.rhs, c2, bv, 0.5 * h, it.held, it.nodes, p)),
+            ("force evaluation + residual", lambda: k(G.residual)(w, nw.rhs, c2, bv, 0.5 * h, it.held, it.nodes, p,
+                                                                  nw.body, nw.groups)),
             ("assembly + factorisation", lambda: k(G.factor_matrix)(w, nw, c2, bv, 0.5 * h, it.nodes, p)),
             ("solve (factored)", lambda: k(solve)(nw.jac.band, nw.jac.corner, nw.cyclic, nw.jac.band.shape[0] - 1,
                                                   nw.rhs, nw.wood))):
