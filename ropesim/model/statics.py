@@ -58,10 +58,11 @@ from .banded import factor as factor_newton_matrix
 from .banded import solve as solve_newton_matrix
 from .banded import woodbury
 from .jacobian import Jacobian, band_width
-from .forces.fluid import WITH_FLUID_DRAG, WITH_VISCOUS_DRAG, add_fluid_tangent_stiffness
+from .forces.fluid import WITH_FLOW, WITH_FLUID_DRAG, WITH_VISCOUS_DRAG, add_fluid_tangent_stiffness
 from .junctions import WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_junctions
 from .body_groups import StaticBodies
 from .schur import model_groups, schur_factor, schur_solve
+from .static_matrix import DifferencedMatrix, apply as apply_rest
 from .terms import accelerations, coupling_reach, mechanical_energy, newton_matrix, velocity_accelerations
 from . import jit
 
@@ -70,6 +71,7 @@ MAX_ITERATIONS = 2000
 KRYLOV_TOL = 1e-10        # GMRES stops when the step's linear residual is this fraction of tau^2 |F|
 KRYLOV_DIMENSION = 80     # ... or after this many Krylov vectors (the step is then inexact; the search judges it)
 MAX_TURN = 0.25          # a free body turns by at most this many radians in one step
+ANALYTIC_MATRIX_METHODS = ("sdirk2", "galpha")   # their loops compile newton_matrix: the static solver shares it
 
 
 @dataclass(frozen=True)
@@ -108,9 +110,8 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     pose = np.array(model.body_pose0 if pose is None else pose, dtype=float)
     dim, n = x.shape
     scene, p = model.scene, model.params
-    acceleration, nonconservative, energy_of, jacobian, tangent_stiffness, factor, solve = (model.kernel(f) for f in (
-        accelerations, nonconservative_forces, mechanical_energy, newton_matrix, add_fluid_tangent_stiffness,
-        factor_newton_matrix, solve_newton_matrix))
+    acceleration, nonconservative, energy_of, factor, solve = (model.kernel(f) for f in (
+        accelerations, nonconservative_forces, mechanical_energy, factor_newton_matrix, solve_newton_matrix))
     free = np.ascontiguousarray(~model.held)
     mass = model.mass
     v = np.zeros_like(x)
@@ -121,6 +122,14 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
     wood = woodbury(nt, m)
     groups = model_groups(model, w)
+    nodes = (free, mass, np.where(model.held, 0.0, model.drag))
+    dragged = {WITH_FLUID_DRAG.name, WITH_VISCOUS_DRAG.name} & model.switches
+    if model.scene.integrator.method in ANALYTIC_MATRIX_METHODS or (cyclic and n < 2 * w + 1):
+        differenced, jacobian, tangent_stiffness = None, model.kernel(newton_matrix), \
+            model.kernel(add_fluid_tangent_stiffness)
+    else:   # an explicit method's loop compiles no Newton matrix: differenced from the loop's own force
+        differenced = DifferencedMatrix(model, acceleration, w, cyclic, free, mass, nodes[2], t,
+                                        model.velocity_dependent)
     bodies = StaticBodies(model, groups, t) if p.bodies is not None else None
     junctions = p.junctions
     if groups.nodes.size:   # a system's free points and bodies: each line banded, they by a Schur complement
@@ -175,31 +184,36 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
         worst = max(float(np.abs(loose).max(initial=0.0)) if np.all(np.isfinite(loose)) else np.inf, bodies.worst())
         return worst, math.hypot(float(np.linalg.norm(loose)), bodies.norm()), energy + bodies.energy(pose)
 
-    nodes = (free, mass, np.where(model.held, 0.0, model.drag))
     force, trial, other = np.zeros(nt), np.zeros(nt), np.zeros(nt)
     scale = _force_scale(model)
     worst, norm, energy = balance(x, pose, force)
     stiffest = max(line.stiffness for line in model.lines)
     tau = math.sqrt(float(mass[free].min()) / max(stiffest, 1e-300))   # one spring's period
     reach = min(line.segment_length for line in model.lines)
-    dragged = {WITH_FLUID_DRAG.name, WITH_VISCOUS_DRAG.name} & model.switches
-    blocks = np.zeros((n, 3, dim, dim)) if dragged else None
+    blocks = np.zeros((n, 3, dim, dim)) if dragged and differenced is None else None
     for iteration in range(1, max_iterations + 1):
         if worst <= tol * scale:
             return Equilibrium(x, worst, scale, iteration - 1, True, pose)
-        jacobian(x, v, jac, tau, nodes, p, t)   # M + tau b + tau^2 K + tau C, so the step is tau^2 F
+        extra = None           # the matrix's part the banded solve leaves out: by GMRES
+        if differenced is not None:
+            rest = differenced.fill(x, jac, tau)   # M + tau b + tau^2 K + tau C, so the step is tau^2 F
+            if dragged and WITH_FLOW.name in model.switches:   # the drag's tangent stiffness in a flow
+                extra = lambda z: folded(apply_rest(rest, z, differenced.rows, differenced.inside))  # noqa: E731
+        else:
+            jacobian(x, v, jac, tau, nodes, p, t)
+            if blocks is not None:
+                blocks[:] = 0.0
+                tangent_stiffness(x, v, blocks, free, p, t)
+                if blocks.any():
+                    extra = lambda z: tau * tau * folded(_apply_blocks(blocks, z, free))  # noqa: E731
         if not factored():
             tau *= 0.25
             continue
         step = force * tau * tau
-        if blocks is not None:
-            blocks[:] = 0.0
-            tangent_stiffness(x, v, blocks, free, p, t)
-        if blocks is None or not blocks.any():
+        if extra is None:
             du = inverse(step)
         else:
-            step, du = _krylov_step(step, inverse, lambda z: tau * tau * folded(_apply_blocks(blocks, z, free)),
-                                     homogeneous)
+            step, du = _krylov_step(step, inverse, extra, homogeneous)
         largest = float(np.abs(step).max())
         shorten = reach / largest if largest > reach else 1.0
         if du is not None:     # a body turns by at most MAX_TURN in one step
