@@ -63,7 +63,9 @@ from .junctions import WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_ju
 from .body_groups import StaticBodies
 from .schur import model_groups, schur_factor, schur_solve
 from .static_matrix import DifferencedMatrix, apply as apply_rest
-from .terms import accelerations, coupling_reach, mechanical_energy, newton_matrix, velocity_accelerations
+from .forces.sea import WITH_SEA
+from .terms import (WITH_APPLIED, accelerations, coupling_reach, mechanical_energy, newton_matrix,
+                    velocity_accelerations)
 from . import jit
 
 TOL = 1e-10
@@ -71,6 +73,7 @@ MAX_ITERATIONS = 2000
 KRYLOV_TOL = 1e-10        # GMRES stops when the step's linear residual is this fraction of tau^2 |F|
 KRYLOV_DIMENSION = 80     # ... or after this many Krylov vectors (the step is then inexact; the search judges it)
 MAX_TURN = 0.25          # a free body turns by at most this many radians in one step
+AT_REST_FORCES = {WITH_FLOW.name, WITH_SEA.name, WITH_APPLIED.name}   # non-conservative terms not 0 at v = 0
 ANALYTIC_MATRIX_METHODS = ("sdirk2", "galpha")   # their loops compile newton_matrix: the static solver shares it
 
 
@@ -185,6 +188,7 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
         return worst, math.hypot(float(np.linalg.norm(loose)), bodies.norm()), energy + bodies.energy(pose)
 
     force, trial, other = np.zeros(nt), np.zeros(nt), np.zeros(nt)
+    moving_fluid = bool(AT_REST_FORCES & model.switches)   # otherwise F_nc = 0 at rest: nothing to compile
     scale = _force_scale(model)
     worst, norm, energy = balance(x, pose, force)
     stiffest = max(line.stiffness for line in model.lines)
@@ -230,7 +234,8 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
             if tau < 1e-30:
                 break
             continue
-        nonconservative(x, v, acc, p, t, mass, free, other)
+        if moving_fluid:
+            nonconservative(x, v, acc, p, t, mass, free, other)
         drift = float(step @ other) + (own_drag if du is not None else 0.0)
         fraction, accepted = 1.0, False
         while fraction > 1e-6:
