@@ -73,7 +73,7 @@ class DifferencedMatrix:
         self.groups = [g[free[g]] for g in colours(n, w, cyclic)]
         self.groups = [g for g in self.groups if g.size]
         self.with_velocity = with_velocity
-        self.reach = min(line.segment_length for line in model.lines)
+        self.dx = SQRT_EPS * min(line.segment_length for line in model.lines)
         flow = model.scene.flow
         speed = max((float(np.abs(np.asarray(u, dtype=float)).max(initial=0.0)) for u in
                      (flow.velocity, flow.velocities) if u is not None), default=0.0) if flow is not None else 0.0
@@ -127,8 +127,7 @@ class DifferencedMatrix:
                     step = moved[e, nodes].copy()
                     self._force(x, moved, self._f1)
                 else:
-                    h = SQRT_EPS * np.maximum(np.abs(x[:, nodes]).max(axis=0), self.reach)
-                    moved[e, nodes] = x[e, nodes] + h
+                    moved[e, nodes] = x[e, nodes] + self.dx
                     step = moved[e, nodes] - x[e, nodes]
                     self._force(moved, base, self._f1)
                 change = self._f1 - self._f0        # (D, N)
