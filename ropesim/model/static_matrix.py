@@ -21,13 +21,24 @@ consecutive nodes that share no term, so one colouring serves them all; a free p
 nodes of their own (the Schur complement maps them to the point's or body's unknowns,
 :mod:`ropesim.model.schur`).
 
-**Step.** Forward differences with h_j = sqrt(eps) max(|x_j|, l) for positions (l the shortest segment) and
-sqrt(eps) max(U, 1 m/s) for velocities (U the flow's speed), each rounded to the step the coordinate actually
-takes ((x + h) - x). sqrt(eps) balances the truncation error, h |F''| / 2, against the round-off of the force,
-eps |F| / h: for F of scale k l (k a segment's stiffness) and F'' of scale k / l, both are sqrt(eps) k, so each
-entry of K is good to about 1e-8 of the springs' stiffness. Newton's step with such a matrix contracts the
-error by about that factor per iteration, so the iteration still reaches the solver's tolerance (1e-10 of the
-largest force) as the analytic matrix does, in the same number of iterations near the solution.
+**Step.** Forward differences: positions moved by h = sqrt(eps) l (l the shortest segment), velocities by
+sqrt(eps) max(U, 1 m/s) (U the flow's largest speed), each step taken as the coordinate actually moves
+((x + h) - x). A term's force changes on the scale of a segment (its direction, its stretch), so the
+truncation error, h |F''| / 2, is about sqrt(eps) k (k a segment's stiffness), and the force's round-off,
+eps k |x| / h, about sqrt(eps) k |x| / l: 1e-6 k for a chain 80 segments from the origin. The step is not
+scaled with |x|, as it usually is, because of the seabed: its contact has a kink where a node touches it, and
+a stiff seabed sinks a node by micrometres (3e-6 m under the spread-moored spar of tests/test_body_statics.py).
+A step of sqrt(eps) |x| (4.5e-6 m, 300 m out) crossed the kink, halved the contact's stiffness at the
+touchdown and stalled that spar's solve at 2 m/s of current (8e-7 of the force scale left after 2000
+iterations); with sqrt(eps) l it takes 169 iterations (the analytic matrix 165).
+
+**Where it serves.** Newton's iteration with this matrix converges as with the analytic one where the
+structure's softest stiffness is well above that error: each built-in static start takes as many iterations
+and its residual after each of the last ones agrees to two digits (``scripts/static_convergence.py``). A beam
+with EI bending is the exception: its softest mode (3 EI / L^3, 4.3 kN/m for cantilever_beam) is 3e-6 of a
+segment's axial stiffness (1.5 GN/m), below the differences' round-off, and the differenced iteration stalled
+at 6e-9 of the force scale. Such a scene takes the analytic matrix, as does any solve whose differenced
+iteration stalls (:func:`ropesim.model.statics.solve_equilibrium`).
 
 **What A holds.** The differenced K is the whole tangent: the springs' compressive geometric stiffness (which
 the analytic matrix leaves out to stay positive definite), the seabed's contact and the drag's dependence on
@@ -114,7 +125,7 @@ class DifferencedMatrix:
 
     def _difference(self, x: np.ndarray, on_velocity: bool, scale: float) -> None:
         """Add ``scale`` times -dF/dx (or -dF/dv) into the blocks, one colour and axis at a time."""
-        dim, n = x.shape
+        dim = x.shape[0]
         base = np.zeros_like(x)
         self._force(x, base, self._f0)
         w = self.w
@@ -139,7 +150,7 @@ class DifferencedMatrix:
     def fill(self, x: np.ndarray, jac, tau: float) -> np.ndarray:
         """Overwrite ``jac``'s band and corner with the symmetric part of A at ``x`` for the pseudo-time step
         ``tau``; returns A's node blocks (2 w + 1, D, D, N) minus their symmetric part (see :func:`apply`)."""
-        dim, n = x.shape
+        dim = x.shape[0]
         free = self.free
         blocks = self.blocks
         blocks[:] = 0.0
@@ -183,7 +194,7 @@ def apply(rest: np.ndarray, z: np.ndarray, rows: np.ndarray, inside: np.ndarray)
 def _added_mass_blocks(x: np.ndarray, added: np.ndarray, around: np.ndarray, free: np.ndarray) -> np.ndarray:
     """Each free node's added-mass block a_n (I - q q^T) + a_t q q^T (D, D, N), q its tangent along the chord
     between its neighbours (:func:`~ropesim.model.forces.fluid.node_tangent`; none for a node without)."""
-    dim, n = x.shape
+    dim = x.shape[0]
     chord = x[:, around[1]] - x[:, around[0]]
     length = np.sqrt((chord * chord).sum(axis=0))
     q = np.divide(chord, length, out=np.zeros_like(chord), where=length > 0.0)

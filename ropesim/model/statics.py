@@ -63,6 +63,7 @@ from .junctions import WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_ju
 from .body_groups import StaticBodies
 from .schur import model_groups, schur_factor, schur_solve
 from .static_matrix import DifferencedMatrix, apply as apply_rest
+from .forces.bending import WITH_EI_BENDING
 from .forces.sea import WITH_SEA
 from .terms import (WITH_APPLIED, accelerations, coupling_reach, mechanical_energy, newton_matrix,
                     velocity_accelerations)
@@ -108,7 +109,23 @@ def forces_on_free_nodes(acceleration, x, v, acc, p, t, mass, free, out, junctio
 def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
                       max_iterations: int = MAX_ITERATIONS, pose: np.ndarray | None = None) -> Equilibrium:
     """The static shape of ``model`` from the guess ``x`` (D, N) (default: its initial positions) and the free
-    bodies' poses ``pose`` (7, B) (default: their initial poses)."""
+    bodies' poses ``pose`` (7, B) (default: their initial poses).
+
+    The Newton matrix is differenced from the scene's compiled force (:mod:`ropesim.model.static_matrix`) unless
+    the scene's method compiles the analytic one anyway (:data:`ANALYTIC_MATRIX_METHODS`) or declares EI
+    bending (a beam's soft modes are below the differences' round-off); should the differenced iteration stall
+    (its pseudo-time step shrunk to nothing), the solve starts again with the analytic matrix."""
+    differenced = not (model.scene.integrator.method in ANALYTIC_MATRIX_METHODS
+                       or WITH_EI_BENDING.name in model.switches)
+    result, stalled = _solve(model, x, tol, max_iterations, pose, differenced)
+    if differenced and stalled:
+        result, _ = _solve(model, x, tol, max_iterations, pose, False)
+    return result
+
+
+def _solve(model, x: np.ndarray | None, tol: float, max_iterations: int, pose: np.ndarray | None,
+           differenced: bool) -> tuple[Equilibrium, bool]:
+    """:func:`solve_equilibrium` with the differenced (or the analytic) Newton matrix; and whether it stalled."""
     x = np.array(model.x0 if x is None else x, dtype=float)
     pose = np.array(model.body_pose0 if pose is None else pose, dtype=float)
     dim, n = x.shape
@@ -127,7 +144,7 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     groups = model_groups(model, w)
     nodes = (free, mass, np.where(model.held, 0.0, model.drag))
     dragged = {WITH_FLUID_DRAG.name, WITH_VISCOUS_DRAG.name} & model.switches
-    if model.scene.integrator.method in ANALYTIC_MATRIX_METHODS or (cyclic and n < 2 * w + 1):
+    if not differenced or (cyclic and n < 2 * w + 1):
         differenced, jacobian, tangent_stiffness = None, model.kernel(newton_matrix), \
             model.kernel(add_fluid_tangent_stiffness)
     else:   # an explicit method's loop compiles no Newton matrix: differenced from the loop's own force
@@ -195,21 +212,22 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     tau = math.sqrt(float(mass[free].min()) / max(stiffest, 1e-300))   # one spring's period
     reach = min(line.segment_length for line in model.lines)
     blocks = np.zeros((n, 3, dim, dim)) if dragged and differenced is None else None
+    stalled = False
     for iteration in range(1, max_iterations + 1):
         if worst <= tol * scale:
-            return Equilibrium(x, worst, scale, iteration - 1, True, pose)
+            return Equilibrium(x, worst, scale, iteration - 1, True, pose), False
         extra = None           # the matrix's part the banded solve leaves out: by GMRES
         if differenced is not None:
             rest = differenced.fill(x, jac, tau)   # M + tau b + tau^2 K + tau C, so the step is tau^2 F
             if dragged and WITH_FLOW.name in model.switches:   # the drag's tangent stiffness in a flow
-                extra = lambda z: folded(apply_rest(rest, z, differenced.rows, differenced.inside))  # noqa: E731
+                extra = lambda z, rest=rest: folded(apply_rest(rest, z, differenced.rows, differenced.inside))
         else:
             jacobian(x, v, jac, tau, nodes, p, t)
             if blocks is not None:
                 blocks[:] = 0.0
                 tangent_stiffness(x, v, blocks, free, p, t)
                 if blocks.any():
-                    extra = lambda z: tau * tau * folded(_apply_blocks(blocks, z, free))  # noqa: E731
+                    extra = lambda z, s=tau * tau: s * folded(_apply_blocks(blocks, z, free))
         if not factored():
             tau *= 0.25
             continue
@@ -232,6 +250,7 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
         if not slope < 0.0:          # not downhill (a non-conservative force turned it): a shorter pseudo-step
             tau *= 0.25
             if tau < 1e-30:
+                stalled = True
                 break
             continue
         if moving_fluid:
@@ -251,6 +270,7 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
         if not accepted:
             tau *= 0.25
             if tau < 1e-30:
+                stalled = True
                 break
             if bodies is not None:
                 balance(x, pose, force)   # the bodies' figures back at x
@@ -260,7 +280,7 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
         x, pose, worst, norm, force, trial, energy = candidate, moved, better, new_norm, trial, force, trial_energy
     if bodies is not None:
         bodies.place(x, pose)
-    return Equilibrium(x, worst, scale, max_iterations, worst <= tol * scale, pose)
+    return Equilibrium(x, worst, scale, max_iterations, worst <= tol * scale, pose), stalled
 
 
 def _apply_blocks(blocks: np.ndarray, z: np.ndarray, free: np.ndarray) -> np.ndarray:
