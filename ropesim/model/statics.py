@@ -6,16 +6,18 @@ of an overdamped implicit step of the dynamics (pseudo-transient continuation),
     (M / tau^2 + C / tau + K) d = F(x),
 
 K the stiffness and C the damping of the force terms (the stiff integrator's Newton matrix, here at zero
-velocity, :func:`ropesim.model.terms.newton_matrix` divided by tau^2), F the net static force (weight,
-buoyancy, springs, bending, the seabed's contact, drag in the flow at its full strength, nodes at rest). With a
-small pseudo-time step tau this is a short gradient step (K alone is singular or indefinite for a slack chain
+velocity, :func:`ropesim.model.terms.newton_matrix` divided by tau^2, where the scene's method compiles it;
+for an explicit method differenced from the compiled force, :mod:`ropesim.model.static_matrix`), F the net
+static force (weight, buoyancy, springs, bending, the seabed's contact, drag in the flow at its full strength,
+nodes at rest). With a small pseudo-time step tau this is a short gradient step (K alone is singular or indefinite for a slack chain
 or at a seabed touchdown); as tau grows it becomes Newton's step. The step is then shortened until it lowers
 the merit
 
     phi(a) = E(x + a d) - a d . F_nc(x),
 
 E the potential energy of the conservative terms (springs, bending, gravity, buoyancy, the seabed's contact)
-and F_nc the rest (drag in the flow), which phi holds at its value at x; its slope at a = 0 is -d . F < 0
+and F_nc the rest (drag in the flow; without a flow, a sea, a thrower or guides every other term's vanishes at
+rest and F_nc is not computed), which phi holds at its value at x; its slope at a = 0 is -d . F < 0
 (Armijo's condition, with a factor 1e-4). Stiff springs make the residual force a poor judge of a step (a
 slack segment drawn 1 cm past its rest length gives 5e6 N on a chain) where the energy is not: the line
 search takes the fraction of the step at which the segment comes taut. A full step doubles tau, a shortened
