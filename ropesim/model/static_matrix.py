@@ -44,9 +44,9 @@ iteration stalls (:func:`ropesim.model.statics.solve_equilibrium`).
 the analytic matrix leaves out to stay positive definite), the seabed's contact and the drag's dependence on
 each node's tangent in a flow. The banded Cholesky takes A's symmetric part, S = (A + A^T) / 2, and the rest,
 A - S, is returned as node blocks for the static solver's Krylov step where a drag in a flow makes it matter
-(:func:`apply`); without a flow it is round-off and left out. Where S is not positive definite (a compressed
-segment at a large pseudo-time step) the factorisation fails and the solver shortens its pseudo-time step, as
-it does with the analytic matrix.
+(:meth:`DifferencedMatrix.apply`); without a flow it is round-off and left out. Where S is not positive
+definite (a compressed segment at a large pseudo-time step) the factorisation fails and the solver shortens
+its pseudo-time step, as it does with the analytic matrix.
 """
 
 from __future__ import annotations
@@ -78,7 +78,7 @@ class DifferencedMatrix:
     def __init__(self, model, acceleration, w: int, cyclic: bool, free: np.ndarray, mass: np.ndarray,
                  drag: np.ndarray, t: float, with_velocity: bool):
         dim, n = model.x0.shape
-        self.acceleration, self.w, self.cyclic, self.t = acceleration, w, cyclic, t
+        self.acceleration, self.w, self.t = acceleration, w, t
         self.free, self.mass, self.drag = free, mass, drag
         self.params = model.params
         self.groups = [g[free[g]] for g in colours(n, w, cyclic)]
@@ -149,7 +149,7 @@ class DifferencedMatrix:
 
     def fill(self, x: np.ndarray, jac, tau: float) -> np.ndarray:
         """Overwrite ``jac``'s band and corner with the symmetric part of A at ``x`` for the pseudo-time step
-        ``tau``; returns A's node blocks (2 w + 1, D, D, N) minus their symmetric part (see :func:`apply`)."""
+        ``tau``; returns A's node blocks (2 w + 1, D, D, N) minus their symmetric part (see :meth:`apply`)."""
         dim = x.shape[0]
         free = self.free
         blocks = self.blocks
@@ -179,16 +179,15 @@ class DifferencedMatrix:
             jac.corner.ravel()[self._corner_target] = symmetric.ravel()[self._corner_source]
         return blocks - symmetric
 
-
-def apply(rest: np.ndarray, z: np.ndarray, rows: np.ndarray, inside: np.ndarray) -> np.ndarray:
-    """(A - S) z for the node blocks ``rest`` of :meth:`DifferencedMatrix.fill` and z flat node-major."""
-    width, dim, _, n = rest.shape
-    zz = z.reshape(n, dim).T
-    out = np.zeros((dim, n))
-    for k in range(width):
-        part = np.einsum("abj,bj->aj", rest[k], zz)
-        np.add.at(out, (slice(None), rows[k][inside[k]]), part[:, inside[k]])
-    return out.T.reshape(-1)
+    def apply(self, rest: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """(A - S) z for the node blocks ``rest`` that :meth:`fill` returned and z flat node-major."""
+        width, dim, _, n = rest.shape
+        zz = z.reshape(n, dim).T
+        out = np.zeros((dim, n))
+        for k in range(width):
+            keep = self.inside[k]
+            np.add.at(out, (slice(None), self.rows[k][keep]), np.einsum("abj,bj->aj", rest[k], zz)[:, keep])
+        return out.T.reshape(-1)
 
 
 def _added_mass_blocks(x: np.ndarray, added: np.ndarray, around: np.ndarray, free: np.ndarray) -> np.ndarray:

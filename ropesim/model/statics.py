@@ -64,7 +64,7 @@ from .forces.fluid import WITH_FLOW, WITH_FLUID_DRAG, WITH_VISCOUS_DRAG, add_flu
 from .junctions import WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_junctions
 from .body_groups import StaticBodies
 from .schur import model_groups, schur_factor, schur_solve
-from .static_matrix import DifferencedMatrix, apply as apply_rest
+from .static_matrix import DifferencedMatrix
 from .forces.bending import WITH_EI_BENDING
 from .forces.sea import WITH_SEA
 from .terms import (WITH_APPLIED, accelerations, coupling_reach, mechanical_energy, newton_matrix,
@@ -222,7 +222,7 @@ def _solve(model, x: np.ndarray | None, tol: float, max_iterations: int, pose: n
         if differenced is not None:
             rest = differenced.fill(x, jac, tau)   # M + tau b + tau^2 K + tau C, so the step is tau^2 F
             if dragged and WITH_FLOW.name in model.switches:   # the drag's tangent stiffness in a flow
-                extra = lambda z, rest=rest: folded(apply_rest(rest, z, differenced.rows, differenced.inside))
+                extra = lambda z, rest=rest: folded(differenced.apply(rest, z))
         else:
             jacobian(x, v, jac, tau, nodes, p, t)
             if blocks is not None:
