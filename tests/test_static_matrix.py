@@ -155,3 +155,31 @@ def test_an_explicit_static_start_compiles_no_newton_matrix(tmp_path):
         assert kernel not in names, kernel
     implicit = _probe(code.replace('"rk4"', '"sdirk2"'), tmp_path / "cache")
     assert "newton_matrix" in implicit
+
+
+def test_a_stalled_differenced_solve_starts_again_with_the_analytic_matrix(monkeypatch):
+    """The safety net: should the differenced iteration stall (its pseudo-time step shrunk to nothing), the
+    solve is repeated from the same guess with the analytic matrix, whose result is returned; EI bending goes to
+    the analytic matrix at once."""
+    import ropesim.model.statics as statics
+
+    calls = []
+
+    def fake(model, x, tol, max_iterations, pose, differenced):
+        calls.append((x, differenced))
+        return f"result {'differenced' if differenced else 'analytic'}", differenced   # the differenced stalls
+
+    monkeypatch.setattr(statics, "_solve", fake)
+    model = build(scene_of(MOORING), solve=False)
+    guess = model.x0 + 0.5
+    assert solve_equilibrium(model, guess) == "result analytic"
+    assert [d for _, d in calls] == [True, False] and calls[0][0] is calls[1][0] is guess
+    calls.clear()
+    sdirk2 = build(scene_of(MOORING, "sdirk2"), solve=False)
+    assert solve_equilibrium(sdirk2) == "result analytic" and [d for _, d in calls] == [False]
+    calls.clear()
+    beam = {"rope": {"length": 2.0, "segments": 4, "mass_per_length": 1.0, "EA": 1.0e5, "EI": 10.0},
+            "initial": {"shape": "line", "start": [0.0, 0.0], "end": [2.0, 0.0]},
+            "pinned": {"nodes": [0]}, "gravity": {"g": 9.81}}
+    assert solve_equilibrium(build(scene_of(beam), solve=False)) == "result analytic"
+    assert [d for _, d in calls] == [False]
