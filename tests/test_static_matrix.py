@@ -22,7 +22,7 @@ import ropesim
 from ropesim.model.build import build
 from ropesim.model.jacobian import Jacobian, band_width
 from ropesim.model.static_matrix import DifferencedMatrix, colours
-from ropesim.model.statics import _steady_time, solve_equilibrium
+from ropesim.model.statics import Equilibrium, _steady_time, solve_equilibrium
 from ropesim.model.terms import accelerations, coupling_reach, newton_matrix
 
 from test_specialise import _probe
@@ -158,28 +158,35 @@ def test_an_explicit_static_start_compiles_no_newton_matrix(tmp_path):
 
 
 def test_a_stalled_differenced_solve_starts_again_with_the_analytic_matrix(monkeypatch):
-    """The safety net: should the differenced iteration stall (its pseudo-time step shrunk to nothing), the
-    solve is repeated from the same guess with the analytic matrix, whose result is returned; EI bending goes to
-    the analytic matrix at once."""
+    """The safety net: should the differenced iteration stall (its pseudo-time step shrunk to nothing) or not
+    converge in the full iteration count, the solve is repeated from the same guess with the analytic matrix,
+    whose result is returned (not after a caller's own shorter limit); sdirk2 and EI bending go to the analytic
+    matrix at once."""
     import ropesim.model.statics as statics
 
     calls = []
 
-    def fake(model, x, tol, max_iterations, pose, differenced):
-        calls.append((x, differenced))
-        return f"result {'differenced' if differenced else 'analytic'}", differenced   # the differenced stalls
+    def solver(stalls: bool):
+        def solve(model, x, tol, max_iterations, pose, differenced):
+            """the differenced iteration fails (stalled, or out of iterations); the analytic one converges"""
+            calls.append((x, differenced))
+            return Equilibrium(model.x0, 0.0, 1.0, 7, not differenced), differenced and stalls
+        return solve
 
-    monkeypatch.setattr(statics, "_solve", fake)
     model = build(scene_of(MOORING), solve=False)
     guess = model.x0 + 0.5
-    assert solve_equilibrium(model, guess) == "result analytic"
-    assert [d for _, d in calls] == [True, False] and calls[0][0] is calls[1][0] is guess
+    for stalls in (True, False):
+        monkeypatch.setattr(statics, "_solve", solver(stalls))
+        calls.clear()
+        assert solve_equilibrium(model, guess).converged
+        assert [d for _, d in calls] == [True, False] and calls[0][0] is calls[1][0] is guess
     calls.clear()
+    assert not solve_equilibrium(model, guess, max_iterations=1).converged   # a caller's own limit
+    assert [d for _, d in calls] == [True]
     sdirk2 = build(scene_of(MOORING, "sdirk2"), solve=False)
-    assert solve_equilibrium(sdirk2) == "result analytic" and [d for _, d in calls] == [False]
-    calls.clear()
     beam = {"rope": {"length": 2.0, "segments": 4, "mass_per_length": 1.0, "EA": 1.0e5, "EI": 10.0},
             "initial": {"shape": "line", "start": [0.0, 0.0], "end": [2.0, 0.0]},
             "pinned": {"nodes": [0]}, "gravity": {"g": 9.81}}
-    assert solve_equilibrium(build(scene_of(beam), solve=False)) == "result analytic"
-    assert [d for _, d in calls] == [False]
+    for analytic in (sdirk2, build(scene_of(beam), solve=False)):
+        calls.clear()
+        assert solve_equilibrium(analytic).converged and [d for _, d in calls] == [False]

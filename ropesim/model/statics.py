@@ -115,12 +115,13 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
 
     The Newton matrix is differenced from the scene's compiled force (:mod:`ropesim.model.static_matrix`) unless
     the scene's method compiles the analytic one anyway (:data:`ANALYTIC_MATRIX_METHODS`) or declares EI
-    bending (a beam's soft modes are below the differences' round-off); should the differenced iteration stall
-    (its pseudo-time step shrunk to nothing), the solve starts again with the analytic matrix."""
+    bending (a beam's soft modes are below the differences' round-off). Should the differenced iteration stall
+    (its pseudo-time step shrunk to nothing) or not converge in the full ``MAX_ITERATIONS``, the solve starts
+    again from the same guess with the analytic matrix: no scene converges with it that did before."""
     differenced = not (model.scene.integrator.method in ANALYTIC_MATRIX_METHODS
                        or WITH_EI_BENDING.name in model.switches)
     result, stalled = _solve(model, x, tol, max_iterations, pose, differenced)
-    if differenced and stalled:
+    if differenced and not result.converged and (stalled or max_iterations >= MAX_ITERATIONS):
         result, _ = _solve(model, x, tol, max_iterations, pose, False)
     return result
 
