@@ -6,16 +6,18 @@ of an overdamped implicit step of the dynamics (pseudo-transient continuation),
     (M / tau^2 + C / tau + K) d = F(x),
 
 K the stiffness and C the damping of the force terms (the stiff integrator's Newton matrix, here at zero
-velocity, :func:`ropesim.model.terms.newton_matrix` divided by tau^2), F the net static force (weight,
-buoyancy, springs, bending, the seabed's contact, drag in the flow at its full strength, nodes at rest). With a
-small pseudo-time step tau this is a short gradient step (K alone is singular or indefinite for a slack chain
+velocity, :func:`ropesim.model.terms.newton_matrix` divided by tau^2, where the scene's method compiles it;
+for an explicit method differenced from the compiled force, :mod:`ropesim.model.static_matrix`), F the net
+static force (weight, buoyancy, springs, bending, the seabed's contact, drag in the flow at its full strength,
+nodes at rest). With a small pseudo-time step tau this is a short gradient step (K alone is singular or indefinite for a slack chain
 or at a seabed touchdown); as tau grows it becomes Newton's step. The step is then shortened until it lowers
 the merit
 
     phi(a) = E(x + a d) - a d . F_nc(x),
 
 E the potential energy of the conservative terms (springs, bending, gravity, buoyancy, the seabed's contact)
-and F_nc the rest (drag in the flow), which phi holds at its value at x; its slope at a = 0 is -d . F < 0
+and F_nc the rest (drag in the flow; without a flow, a sea, a thrower or guides every other term's vanishes at
+rest and F_nc is not computed), which phi holds at its value at x; its slope at a = 0 is -d . F < 0
 (Armijo's condition, with a factor 1e-4). Stiff springs make the residual force a poor judge of a step (a
 slack segment drawn 1 cm past its rest length gives 5e6 N on a chain) where the energy is not: the line
 search takes the fraction of the step at which the segment comes taut. A full step doubles tau, a shortened
@@ -58,11 +60,15 @@ from .banded import factor as factor_newton_matrix
 from .banded import solve as solve_newton_matrix
 from .banded import woodbury
 from .jacobian import Jacobian, band_width
-from .forces.fluid import WITH_FLUID_DRAG, WITH_VISCOUS_DRAG, add_fluid_tangent_stiffness
+from .forces.fluid import WITH_FLOW, WITH_FLUID_DRAG, WITH_VISCOUS_DRAG, add_fluid_tangent_stiffness
 from .junctions import WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_junctions
 from .body_groups import StaticBodies
 from .schur import model_groups, schur_factor, schur_solve
-from .terms import accelerations, coupling_reach, mechanical_energy, newton_matrix, velocity_accelerations
+from .static_matrix import DifferencedMatrix
+from .forces.bending import WITH_EI_BENDING
+from .forces.sea import WITH_SEA
+from .terms import (WITH_APPLIED, accelerations, coupling_reach, mechanical_energy, newton_matrix,
+                    velocity_accelerations)
 from . import jit
 
 TOL = 1e-10
@@ -70,6 +76,8 @@ MAX_ITERATIONS = 2000
 KRYLOV_TOL = 1e-10        # GMRES stops when the step's linear residual is this fraction of tau^2 |F|
 KRYLOV_DIMENSION = 80     # ... or after this many Krylov vectors (the step is then inexact; the search judges it)
 MAX_TURN = 0.25          # a free body turns by at most this many radians in one step
+AT_REST_FORCES = {WITH_FLOW.name, WITH_SEA.name, WITH_APPLIED.name}   # non-conservative terms not 0 at v = 0
+ANALYTIC_MATRIX_METHODS = ("sdirk2", "galpha")   # their loops compile newton_matrix: the static solver shares it
 
 
 @dataclass(frozen=True)
@@ -103,14 +111,30 @@ def forces_on_free_nodes(acceleration, x, v, acc, p, t, mass, free, out, junctio
 def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
                       max_iterations: int = MAX_ITERATIONS, pose: np.ndarray | None = None) -> Equilibrium:
     """The static shape of ``model`` from the guess ``x`` (D, N) (default: its initial positions) and the free
-    bodies' poses ``pose`` (7, B) (default: their initial poses)."""
+    bodies' poses ``pose`` (7, B) (default: their initial poses).
+
+    The Newton matrix is differenced from the scene's compiled force (:mod:`ropesim.model.static_matrix`) unless
+    the scene's method compiles the analytic one anyway (:data:`ANALYTIC_MATRIX_METHODS`) or declares EI
+    bending (a beam's soft modes are below the differences' round-off). Should the differenced iteration stall
+    (its pseudo-time step shrunk to nothing) or not converge in the full ``MAX_ITERATIONS``, the solve starts
+    again from the same guess with the analytic matrix: no scene converges with it that did before."""
+    differenced = not (model.scene.integrator.method in ANALYTIC_MATRIX_METHODS
+                       or WITH_EI_BENDING.name in model.switches)
+    result, stalled = _solve(model, x, tol, max_iterations, pose, differenced)
+    if differenced and not result.converged and (stalled or max_iterations >= MAX_ITERATIONS):
+        result, _ = _solve(model, x, tol, max_iterations, pose, False)
+    return result
+
+
+def _solve(model, x: np.ndarray | None, tol: float, max_iterations: int, pose: np.ndarray | None,
+           differenced: bool) -> tuple[Equilibrium, bool]:
+    """:func:`solve_equilibrium` with the differenced (or the analytic) Newton matrix; and whether it stalled."""
     x = np.array(model.x0 if x is None else x, dtype=float)
     pose = np.array(model.body_pose0 if pose is None else pose, dtype=float)
     dim, n = x.shape
     scene, p = model.scene, model.params
-    acceleration, nonconservative, energy_of, jacobian, tangent_stiffness, factor, solve = (model.kernel(f) for f in (
-        accelerations, nonconservative_forces, mechanical_energy, newton_matrix, add_fluid_tangent_stiffness,
-        factor_newton_matrix, solve_newton_matrix))
+    acceleration, nonconservative, energy_of, factor, solve = (model.kernel(f) for f in (
+        accelerations, nonconservative_forces, mechanical_energy, factor_newton_matrix, solve_newton_matrix))
     free = np.ascontiguousarray(~model.held)
     mass = model.mass
     v = np.zeros_like(x)
@@ -121,6 +145,14 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
     wood = woodbury(nt, m)
     groups = model_groups(model, w)
+    nodes = (free, mass, np.where(model.held, 0.0, model.drag))
+    dragged = {WITH_FLUID_DRAG.name, WITH_VISCOUS_DRAG.name} & model.switches
+    if not differenced or (cyclic and n < 2 * w + 1):
+        differenced, jacobian, tangent_stiffness = None, model.kernel(newton_matrix), \
+            model.kernel(add_fluid_tangent_stiffness)
+    else:   # an explicit method's loop compiles no Newton matrix: differenced from the loop's own force
+        differenced = DifferencedMatrix(model, acceleration, w, cyclic, free, mass, nodes[2], t,
+                                        model.velocity_dependent)
     bodies = StaticBodies(model, groups, t) if p.bodies is not None else None
     junctions = p.junctions
     if groups.nodes.size:   # a system's free points and bodies: each line banded, they by a Schur complement
@@ -175,31 +207,38 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
         worst = max(float(np.abs(loose).max(initial=0.0)) if np.all(np.isfinite(loose)) else np.inf, bodies.worst())
         return worst, math.hypot(float(np.linalg.norm(loose)), bodies.norm()), energy + bodies.energy(pose)
 
-    nodes = (free, mass, np.where(model.held, 0.0, model.drag))
     force, trial, other = np.zeros(nt), np.zeros(nt), np.zeros(nt)
+    moving_fluid = bool(AT_REST_FORCES & model.switches)   # otherwise F_nc = 0 at rest: nothing to compile
     scale = _force_scale(model)
     worst, norm, energy = balance(x, pose, force)
     stiffest = max(line.stiffness for line in model.lines)
     tau = math.sqrt(float(mass[free].min()) / max(stiffest, 1e-300))   # one spring's period
     reach = min(line.segment_length for line in model.lines)
-    dragged = {WITH_FLUID_DRAG.name, WITH_VISCOUS_DRAG.name} & model.switches
-    blocks = np.zeros((n, 3, dim, dim)) if dragged else None
+    blocks = np.zeros((n, 3, dim, dim)) if dragged and differenced is None else None
+    stalled = False
     for iteration in range(1, max_iterations + 1):
         if worst <= tol * scale:
-            return Equilibrium(x, worst, scale, iteration - 1, True, pose)
-        jacobian(x, v, jac, tau, nodes, p, t)   # M + tau b + tau^2 K + tau C, so the step is tau^2 F
+            return Equilibrium(x, worst, scale, iteration - 1, True, pose), False
+        extra = None           # the matrix's part the banded solve leaves out: by GMRES
+        if differenced is not None:
+            rest = differenced.fill(x, jac, tau)   # M + tau b + tau^2 K + tau C, so the step is tau^2 F
+            if dragged and WITH_FLOW.name in model.switches:   # the drag's tangent stiffness in a flow
+                extra = lambda z, rest=rest: folded(differenced.apply(rest, z))
+        else:
+            jacobian(x, v, jac, tau, nodes, p, t)
+            if blocks is not None:
+                blocks[:] = 0.0
+                tangent_stiffness(x, v, blocks, free, p, t)
+                if blocks.any():
+                    extra = lambda z, s=tau * tau: s * folded(_apply_blocks(blocks, z, free))
         if not factored():
             tau *= 0.25
             continue
         step = force * tau * tau
-        if blocks is not None:
-            blocks[:] = 0.0
-            tangent_stiffness(x, v, blocks, free, p, t)
-        if blocks is None or not blocks.any():
+        if extra is None:
             du = inverse(step)
         else:
-            step, du = _krylov_step(step, inverse, lambda z: tau * tau * folded(_apply_blocks(blocks, z, free)),
-                                     homogeneous)
+            step, du = _krylov_step(step, inverse, extra, homogeneous)
         largest = float(np.abs(step).max())
         shorten = reach / largest if largest > reach else 1.0
         if du is not None:     # a body turns by at most MAX_TURN in one step
@@ -214,9 +253,11 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
         if not slope < 0.0:          # not downhill (a non-conservative force turned it): a shorter pseudo-step
             tau *= 0.25
             if tau < 1e-30:
+                stalled = True
                 break
             continue
-        nonconservative(x, v, acc, p, t, mass, free, other)
+        if moving_fluid:
+            nonconservative(x, v, acc, p, t, mass, free, other)
         drift = float(step @ other) + (own_drag if du is not None else 0.0)
         fraction, accepted = 1.0, False
         while fraction > 1e-6:
@@ -232,6 +273,7 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
         if not accepted:
             tau *= 0.25
             if tau < 1e-30:
+                stalled = True
                 break
             if bodies is not None:
                 balance(x, pose, force)   # the bodies' figures back at x
@@ -241,7 +283,7 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
         x, pose, worst, norm, force, trial, energy = candidate, moved, better, new_norm, trial, force, trial_energy
     if bodies is not None:
         bodies.place(x, pose)
-    return Equilibrium(x, worst, scale, max_iterations, worst <= tol * scale, pose)
+    return Equilibrium(x, worst, scale, max_iterations, worst <= tol * scale, pose), stalled
 
 
 def _apply_blocks(blocks: np.ndarray, z: np.ndarray, free: np.ndarray) -> np.ndarray:
