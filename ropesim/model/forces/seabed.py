@@ -54,6 +54,29 @@ def depth(px, py, bed):
     return (bed[0] + bed[1] * px - py) * bed[2]
 
 
+@jit.kernel(inline="always")
+def inward(vn, scale):
+    """min(v_n, 0) made C1 over -scale < v_n < 0 [m/s]: -scale (2 u^2 - u^3), u = -v_n / scale, there (exact
+    outside, rising monotonically: slope u (4 - 3 u) in 0..4/3, 0 at rest); galpha's one-way damping switch."""
+    if vn >= 0.0:
+        return 0.0
+    if vn <= -scale:
+        return vn
+    u = -vn / scale
+    return -scale * u * u * (2.0 - u)
+
+
+@jit.kernel(inline="always")
+def inward_slope(vn, scale):
+    """d inward / d v_n."""
+    if vn >= 0.0:
+        return 0.0
+    if vn <= -scale:
+        return 1.0
+    u = -vn / scale
+    return u * (4.0 - 3.0 * u)
+
+
 @jit.kernel
 def add_seabed_contact(x, acc, inv_mass, seabed):
     """Add the contact spring's acceleration k delta A n / m [m/s^2] of every node in contact."""
@@ -86,6 +109,8 @@ def add_seabed_friction(x, v, acc, inv_mass, seabed, around):
             damp = c * area[i] * vn   # MoorDyn's: both ways, at full strength
             if bed[10] > 1.0:   # galpha's: both ways, grown in over delta_d
                 damp *= min(1.0, sunk / bed[9])
+        elif bed[10] < 0.0:   # galpha's: into the plane only, the switch at v . n = 0 smoothed over v_reg
+            damp = c * area[i] * min(1.0, sunk / bed[9]) * inward(vn, v_reg)
         else:
             damp = c * area[i] * min(1.0, sunk / bed[9]) * min(vn, 0.0)   # resists motion into the plane only
         fx = -damp * nx
@@ -152,6 +177,10 @@ def add_seabed_jacobian(x, v, band, beta, free, seabed, friction):
                 along_n -= beta * beta * bed[5] * area[i] * vn / bed[9]
         elif bed[10] > 0.0:
             along_n += beta * bed[5] * area[i]
+        elif bed[10] < 0.0:
+            along_n += beta * bed[5] * area[i] * min(1.0, sunk / bed[9]) * inward_slope(vn, bed[8])
+            if sunk < bed[9]:
+                along_n -= beta * beta * bed[5] * area[i] * inward(vn, bed[8]) / bed[9]
         elif vn < 0.0:
             along_n += beta * bed[5] * area[i] * min(1.0, sunk / bed[9])
             if sunk < bed[9]:
@@ -176,8 +205,9 @@ def _params(scene, layout) -> tuple:
     scalars = np.array([bed.height, math.tan(a), math.cos(a), math.sin(a), bed.stiffness, bed.damping, bed.friction,
                         bed.friction if bed.friction_axial is None else bed.friction_axial, bed.friction_speed,
                         DAMPING_DEPTH * float(width.max(initial=0.0)), 1.0 if bed.damping_both_ways else 0.0])
-    if bed.damping_both_ways and scene.integrator.method == "galpha":
-        scalars[10] = 2.0   # MoorDyn's law grown in over delta_d: a force without a jump for galpha's Newton solve
+    if scene.integrator.method == "galpha":   # forces without a jump or a kink in v . n for its Newton solve:
+        scalars[10] = 2.0 if bed.damping_both_ways else -1.0   # MoorDyn's law grown in over delta_d; the one-way
+        # law's switch at rest smoothed over v_reg
     return scalars, width * layout.node_length
 
 
