@@ -19,7 +19,11 @@ delta = -s. On its footprint A = contact_width x L (L its share of unstretched l
   Newton solve meets that jump at every landing and lift-off (c A |v . n|, 1.3 kN for WD0050's chain landing at
   0.1 m/s: at 0.1 s steps it failed at most touchdowns): there it grows in over the same delta_d,
   -c (v . n) A f (the regularisation; its effect on WD0050's fairlead tension is measured on the accuracy page,
-  "Moorings at the sea's time scale");
+  "Moorings at the sea's time scale"). ropesim's own law has a kink at rest instead, where the damping switches
+  on (v . n < 0) and off: a resting node's Newton iterates flipped between damped and free, and galpha failed
+  Newton at the thrown spar's second 0.1 s step. For galpha its min(v . n, 0) is C1 over v_reg
+  (``friction_speed``): -v_reg (2 u^2 - u^3), u = -v . n / v_reg, for -v_reg < v . n < 0 (:func:`inward`;
+  monotone, never pulling a node in; exact outside);
 - friction against its sliding velocity v_s = v - (v . n) n, split along the rope (the node tangent projected
   on the plane, t_s) and across it: F = -N (mu_axial (v_s . t_s) t_s + mu (v_s - (v_s . t_s) t_s)) /
   sqrt(|v_s|^2 + v_reg^2), N = k delta A the spring's normal load. Well above v_reg (``friction_speed``) this
@@ -29,7 +33,8 @@ delta = -s. On its footprint A = contact_width x L (L its share of unstretched l
 The damping and friction depend on velocity; their work is the energy ledger's ``seabed_work``.
 
 Parameters: ``seabed`` = (scalars [height, tan a, cos a, sin a, k, c, mu, mu_axial, v_reg, delta_d,
-both ways (1), both ways grown in over delta_d (2, galpha's) or into the plane only (0)], footprint (N,) [m^2]).
+both ways (1), both ways grown in over delta_d (2, galpha's), into the plane only (0) or so with its switch
+smoothed over v_reg (-1, galpha's)], footprint (N,) [m^2]).
 """
 
 from __future__ import annotations
