@@ -381,14 +381,19 @@ def target_table(best: dict) -> str:
     return "\n".join(lines)
 
 
+def config_label(best: dict) -> str:
+    """A cheapest configuration's step (``0.1 ms``) or tolerance (``tol=0.01``)."""
+    return best["method"].partition(" ")[2] or f"{best['dt_s'] * 1e3:.3g} ms"
+
+
 def sweep_table(sweep: list[dict]) -> str:
     keys = ["ropesim verlet", "ropesim rk4", "ropesim sdirk2", "ropesim galpha", "ropesim galpha adaptive"]
     lines = ["| EA (N) | accuracy | " + " | ".join(keys) + " | sdirk2 / best explicit ropesim |",
              "| --- | --- |" + " --- |" * (len(keys) + 1)]
     for s in sweep:
         for target, per in s["cheapest"].items():
-            cells = [f"{per[k]['wall_per_s'] * 1e3:.2f} ms/s ({per[k]['method'].partition(' ')[2] or per[k]['dt_s'] * 1e3:.3g}"
-                     f"{'' if ' tol=' in per[k]['method'] else ' ms'})" if k in per else "—" for k in keys]
+            cells = [f"{per[k]['wall_per_s'] * 1e3:.2f} ms/s ({config_label(per[k])})" if k in per else "—"
+                     for k in keys]
             explicit = [per[k]["wall_per_s"] for k in keys[:2] if k in per]
             ratio = (f"{per['ropesim sdirk2']['wall_per_s'] / min(explicit):.2f}"
                      if explicit and "ropesim sdirk2" in per else "")
