@@ -3,8 +3,9 @@
 spread_mooring_free with its spar thrown from its balance (0.5 m/s downstream, 0.2 m/s across, turning at
 0.3 deg/s about its axis), over 30 s: the error at the end (the spar's reference point, every chain node)
 against rk4 at 1 ms, and the CPU seconds of each loop (compiled or loaded before the clock starts), all in one
-process: compare the ratios. ``--no-seabed-damping`` switches MoorDyn's two-way seabed damping off (what limits
-galpha's steps on this scene; the body does not).
+process: compare the ratios. galpha at its default rho_inf (0.9) and at 0 (the moorings' setting), with its Newton
+iterations and factorisations (whole run). ``--no-seabed-damping`` switches the seabed's contact damping off (what
+limits galpha's fixed steps on this scene at rho_inf 0.9; the body does not).
 
     python scripts/bench_galpha_bodies.py [--t-end 30] [--no-seabed-damping]
 """
@@ -49,21 +50,26 @@ def main() -> None:
     scene = thrown_spar(not args.no_seabed_damping)
     reference = run(scene, args.t_end, "rk4", 1e-3)[0]
     cases = [("rk4", 0.004, {}), ("rk4", 0.002, {})]
-    cases += [("galpha", dt, {}) for dt in (0.5, 0.2, 0.1, 0.05)]
-    cases += [("galpha", 0.5, {"tolerance": tol}) for tol in (1e-1, 1e-2, 1e-3)]
-    print("| method | dt [s] | tolerance [m] | CPU [s] | error spar [m] | error nodes [m] | steps |")
-    print("|---|---|---|---|---|---|---|")
+    for rho in (None, 0.0):   # galpha's default rho_inf (0.9), and 0 (the moorings' setting)
+        keys = {} if rho is None else {"rho_inf": rho}
+        cases += [("galpha", dt, keys) for dt in (0.5, 0.2, 0.1, 0.05)]
+        cases += [("galpha", 0.5, {"tolerance": tol, **keys}) for tol in (1e-1, 1e-2, 1e-3)]
+    print("| method | rho_inf | dt [s] | tolerance [m] | CPU [s] | error spar [m] | error nodes [m] | steps | "
+          "Newton iterations | factorisations |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for method, dt, keys in cases:
         it, result, cpu = run(scene, args.t_end, method, dt, **keys)
         report = it.step_report() if method == "galpha" else None
         steps = report["steps_taken"] if report else it.step
+        rho = f"{it.rho_inf:g}" if method == "galpha" else "-"
+        head = f"| {method} | {rho} | {dt:g} | {keys.get('tolerance', '-')} |"
         if result.status:
-            print(f"| {method} | {dt:g} | {keys.get('tolerance', '-')} | - | Newton failed at t = {it.t:.4g} s | | |")
+            print(f"{head} - | Newton failed at t = {it.t:.4g} s | | | | |", flush=True)
             continue
         spar = np.abs(it.pose[:3] - reference.pose[:3]).max()
         nodes = np.abs(it.x - reference.x).max()
-        print(f"| {method} | {dt:g} | {keys.get('tolerance', '-')} | {cpu:.3f} | {spar:.2e} | {nodes:.2e} | {steps} |",
-              flush=True)
+        newton = f"{it.stats[0]} | {it.stats[1]}" if method == "galpha" else "- | -"
+        print(f"{head} {cpu:.3f} | {spar:.2e} | {nodes:.2e} | {steps} | {newton} |", flush=True)
 
 
 if __name__ == "__main__":

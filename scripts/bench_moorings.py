@@ -36,6 +36,16 @@ window, each method's cheapest configuration reaching 1 % and 0.1 % against an r
     python scripts/bench_moorings.py [--repeats 3] [--window 120] [--points 4] [--no-sweep] \\
         [--json docs/data/moorings_speed.json] [--figure docs/images/moorings_speed.png]
 
+``--fluid`` instead times galpha (fixed steps and tolerances, ``--galpha-rho``) against MoorDyn's RK2 and RK4 on
+the three equal-physics fluid cases of tests/references/moordyn_equal_physics.py (current, towed, catenary; full
+size, their first ``--fluid-window`` seconds, no seabed), each code against its own RK4 at a small step, the
+error the top tension's RMS over its range; the cheapest configuration of each code at 1 % and 0.1 %:
+
+    python scripts/bench_moorings.py --fluid [current,towed,catenary] [--fluid-window 20] [--repeats 2]
+
+The error counts the first seconds, where the current switches on (or the tow starts, or the catenary is
+released) at t = 0 and sets off axial waves; galpha at rho_inf 0 damps those in a step.
+
 About 6 minutes on the shared 2-core machine at load average 1 to 2, 13 at load 4 to 6 (half without the sweep).
 """
 
@@ -377,13 +387,18 @@ def target_table(best: dict) -> str:
     return "\n".join(lines)
 
 
+def config_label(best: dict) -> str:
+    """A cheapest configuration's step (``0.1 ms``) or tolerance (``tol=0.01``)."""
+    return best["method"].partition(" ")[2] or f"{best['dt_s'] * 1e3:.3g} ms"
+
+
 def sweep_table(sweep: list[dict]) -> str:
-    keys = ["ropesim verlet", "ropesim rk4", "ropesim sdirk2"]
+    keys = ["ropesim verlet", "ropesim rk4", "ropesim sdirk2", "ropesim galpha", "ropesim galpha adaptive"]
     lines = ["| EA (N) | accuracy | " + " | ".join(keys) + " | sdirk2 / best explicit ropesim |",
              "| --- | --- |" + " --- |" * (len(keys) + 1)]
     for s in sweep:
         for target, per in s["cheapest"].items():
-            cells = [f"{per[k]['wall_per_s'] * 1e3:.2f} ms/s ({per[k]['dt_s'] * 1e3:.3g} ms)" if k in per else "—"
+            cells = [f"{per[k]['wall_per_s'] * 1e3:.2f} ms/s ({config_label(per[k])})" if k in per else "—"
                      for k in keys]
             explicit = [per[k]["wall_per_s"] for k in keys[:2] if k in per]
             ratio = (f"{per['ropesim sdirk2']['wall_per_s'] / min(explicit):.2f}"
@@ -446,7 +461,189 @@ def draw(rows: list[dict], sweep: list[dict], floor: float, path: Path, window: 
     plt.close(fig)
 
 
+# ------------------------------------------------------------------------------------------------ fluid cases
+
+#: galpha's configurations on the equal-physics fluid cases: fixed steps DT_OUT / k and tolerances [m]
+FLUID_GALPHA_KS = (1, 2, 4, 8, 16, 32)
+FLUID_GALPHA_TOLERANCES = (1e-1, 1e-2, 1e-3, 1e-4)
+#: MoorDyn's steps tried from the largest down (s); its largest stable RK2 step is 0.4 ms on the hanging line and
+#: 0.6 ms on the catenary (scripts/compare_moordyn.py), RK4's a little larger
+FLUID_MOORDYN_DTS = (8.0e-4, 6.0e-4, 5.0e-4, 4.0e-4, 3.0e-4, 2.0e-4)
+
+
+def fluid_runs(name: str, window: float):
+    """The equal-physics case ``name`` (tests/references/moordyn_equal_physics.py, full size) cut to ``window``
+    seconds, its shared start (MoorDyn's initial state) and a runner (code, method, dt) -> (top tension (F,) or
+    None, wall time of the time loop [s])."""
+    import tomli_w
+
+    import ropesim
+    from references.moordyn_equal_physics import CASES, Series, ropesim_scene_dict, run_moordyn
+
+    case = CASES[name].with_(t_end=min(CASES[name].t_end, window))
+    start = run_moordyn(case, t_end=case.dt_out).positions[0]
+
+    def runner(code: str, method: str, dt: float):
+        if code == "MoorDyn":
+            try:
+                out = Series.of_moordyn(run_moordyn(case, dtM=dt, scheme=method))
+            except RuntimeError:
+                return None, math.nan
+            frames = int(round(case.t_end / case.dt_out)) + 1
+            ok = out.top.size == frames and np.all(np.isfinite(out.top)) and np.all(np.isfinite(out.x))
+            ok = ok and float(np.abs(out.x).max()) < 1e3
+            return (out.top if ok else None), out.wall
+        scheme, _, tol = method.partition(" tol=")
+        d = ropesim_scene_dict(case, start, method=scheme, dt=dt)
+        if scheme == "galpha":
+            d["integrator"]["rho_inf"] = GALPHA["rho_inf"]
+            if tol:
+                d["integrator"]["tolerance"] = float(tol)
+        traj = ropesim.simulate(ropesim.scene_from_toml(tomli_w.dumps(d)))
+        if traj.summary["status"] != "completed":
+            return None, math.nan
+        return Series.of_ropesim(traj).top, traj.summary["wall_time_s"]
+
+    return case, start, runner
+
+
+def fluid_case(name: str, window: float, repeats: int) -> dict:
+    """galpha against MoorDyn on one equal-physics case: each code's converged answer (its RK4 at a small step,
+    checked against twice that step), every configuration timed ``repeats`` rounds (the fastest kept), the top
+    tension's RMS error over the reference's range, and the cheapest configuration of each reaching 1 % and 0.1 %."""
+    from ropesim.analysis.stability import predicted_dt
+    from ropesim.model.build import build
+    from references.moordyn_equal_physics import ropesim_scene
+
+    case, start, runner = fluid_runs(name, window)
+    rk4_bound = predicted_dt(build(ropesim_scene(case, start, method="rk4", dt=1e-4)), "rk4")
+    k = k_at_most(0.1 * rk4_bound)
+    refs, ref_info = {}, {}
+    for code, method, dt, check in (("ropesim", "rk4", step_of(k), step_of(max(1, k // 2))),
+                                    ("MoorDyn", "RK4", 5.0e-5, 1.0e-4)):
+        fine, _ = runner(code, method, dt)
+        half, _ = runner(code, method, check)
+        if fine is None or half is None:
+            raise RuntimeError(f"{name}: {code}'s reference run did not complete")
+        refs[code] = fine
+        ref_info[code] = {"method": method, "dt_s": dt, "check_dt_s": check, "check_rms_of_range":
+                          float(np.sqrt(np.mean((fine[1:] - half[1:]) ** 2)) / np.ptp(fine[1:]))}
+    configs = [("ropesim", "galpha", step_of(k)) for k in FLUID_GALPHA_KS]
+    configs += [("ropesim", f"galpha tol={tol:g}", DT_OUT) for tol in FLUID_GALPHA_TOLERANCES]
+    for scheme in MOORDYN_SCHEMES:   # from the largest step that stays finite down
+        stable = [dt for dt in FLUID_MOORDYN_DTS if runner("MoorDyn", scheme, dt)[0] is not None]
+        configs += [("MoorDyn", scheme, dt) for dt in stable[:3]]
+    rows = [{"code": c, "method": m, "dt_s": dt, "walls": [], "ok": True} for c, m, dt in configs]
+    for _ in range(repeats):
+        for row in rows:
+            if not row["ok"]:
+                continue
+            top, wall = runner(row["code"], row["method"], row["dt_s"])
+            if top is None:
+                row.update(ok=False)
+                continue
+            row["walls"].append(wall)
+            ref = refs[row["code"]]
+            row["error"] = float(np.sqrt(np.mean((top[1:] - ref[1:]) ** 2)) / np.ptp(ref[1:]))
+    for row in rows:
+        if row["ok"]:
+            row["wall_per_s"] = min(row["walls"]) / case.t_end
+            row["real_time_factor"] = 1.0 / row["wall_per_s"]
+    best = cheapest(rows, TARGETS[:2])
+    ratios = {}
+    for target, per in best.items():
+        moordyn = [v["wall_per_s"] for key, v in per.items() if key.startswith("MoorDyn")]
+        galpha = [v["wall_per_s"] for key, v in per.items() if key.startswith("ropesim galpha")]
+        ratios[target] = min(moordyn) / min(galpha) if moordyn and galpha else None
+    return {"case": name, "window_s": case.t_end, "nodes": case.segments + 1, "references": ref_info,
+            "rows": rows, "cheapest": best, "moordyn_over_galpha": ratios}
+
+
+def fluid_table(results: list[dict]) -> str:
+    lines = ["| case | accuracy | galpha (cheapest) | MoorDyn (cheapest) | MoorDyn / galpha |", "|---|---|---|---|---|"]
+    for r in results:
+        for target, per in r["cheapest"].items():
+            def cell(prefix):
+                rows = [(v["wall_per_s"], v) for key, v in per.items() if key.startswith(prefix)]
+                if not rows:
+                    return "not reached"
+                _, v = min(rows, key=lambda p: p[0])
+                return f"{1e3 * v['wall_per_s']:.2f} ms/s ({v['method']}, {1e3 * v['dt_s']:g} ms; {100 * v['error']:.2g} %)"
+            ratio = r["moordyn_over_galpha"][target]
+            lines.append(f"| {r['case']} ({r['nodes']} nodes, {r['window_s']:g} s) | {float(target) * 100:g} % | "
+                         f"{cell('ropesim galpha')} | {cell('MoorDyn')} | "
+                         f"{'-' if ratio is None else f'{ratio:.1f}x'} |")
+    return "\n".join(lines)
+
+
+def fluid_main(args) -> int:
+    """``--fluid``: the three equal-physics fluid cases, galpha against MoorDyn (the issue's >= 5x at 1 %)."""
+    from references.moordyn_harness import moordyn_version
+
+    started = time.perf_counter()
+    results = []
+    for name in args.fluid.split(","):
+        print(f"{name}, {args.fluid_window:g} s ...", flush=True)
+        results.append(fluid_case(name, args.fluid_window, args.repeats))
+    try:
+        load = os.getloadavg()
+    except OSError:
+        load = None
+    out = {"made_by": "scripts/bench_moorings.py --fluid", "moordyn_version": moordyn_version(),
+           "galpha_rho_inf": GALPHA["rho_inf"], "load_average_after": load,
+           "accuracy": "RMS of the top tension's difference from the code's own converged answer over the window, "
+                       "divided by that answer's range", "cases": results}
+    args.json.parent.mkdir(parents=True, exist_ok=True)
+    args.json.write_text(json.dumps(out, indent=1) + "\n", encoding="utf-8")
+    for r in results:
+        print(f"\n{r['case']}: references {r['references']}")
+        for row in r["rows"]:
+            err = f"{100 * row['error']:.3g} %" if row["ok"] else "failed"
+            wall = f"{1e3 * row['wall_per_s']:.2f} ms/s" if row["ok"] else ""
+            print(f"  {row['code']} {row['method']} {1e3 * row['dt_s']:g} ms: {err} {wall}")
+    print("\n" + fluid_table(results))
+    print(f"\nwrote {args.json}; load average {load}; total {time.perf_counter() - started:.0f} s")
+    return 0
+
+
 # ------------------------------------------------------------------------------------------------ main
+
+
+def stiff_sweep(args) -> list[dict]:
+    """The EA sweep (ropesim only, each EA against its own rk4 reference); ``--only`` keeps those methods."""
+    sweep = []
+    for EA in (float(e) for e in args.sweep_ea.split(",")):
+        print(f"EA = {EA:.0e} N, {SWEEP_WINDOW:g} s ...", flush=True)
+        c, s0 = problem(EA)
+        r, r_info = reference(c, s0, SWEEP_WINDOW)
+        cfg, n = configurations(c, s0, SWEEP_WINDOW, 4, moordyn=False)
+        if args.only:
+            keep = set(args.only.split(","))
+            cfg = [x for x in cfg if x[1].split(" tol=")[0] in keep]
+        sweep_rows = measure(c, s0, cfg, {"ropesim": r}, SWEEP_WINDOW, max(1, args.repeats - 1))
+        sweep.append({"EA": EA, "BA": c.BA, "reference": r_info, "notes": n, "rows": sweep_rows,
+                      "cheapest": cheapest(sweep_rows, TARGETS[:2])})
+    return sweep
+
+
+def sweep_main(args, started: float) -> int:
+    """``--sweep-only``: the stiff chains alone, printed and written to ``--json``."""
+    sweep = stiff_sweep(args)
+    for s in sweep:
+        print(f"\nEA {s['EA']:.0e} N: reference {s['reference']}")
+        for row in s["rows"]:
+            err = f"{100 * row['error']:.3g} %" if row["ok"] else f"failed ({row.get('status', '')})"
+            wall = f"{1e3 * row['wall_per_s']:.2f} ms/s" if row["ok"] else ""
+            print(f"  {row['method']} {1e3 * row['dt_s']:.3g} ms: {err} {wall}")
+    print(f"\n## Stiffer chains ({SWEEP_WINDOW:g} s)\n")
+    print(sweep_table(sweep))
+    load = os.getloadavg()
+    args.json.parent.mkdir(parents=True, exist_ok=True)
+    args.json.write_text(json.dumps({"made_by": "scripts/bench_moorings.py --sweep-only", "galpha_rho_inf":
+                                     GALPHA["rho_inf"], "sweep": sweep, "sweep_window_s": SWEEP_WINDOW,
+                                     "load_average_after": load}, indent=1) + "\n", encoding="utf-8")
+    print(f"\nwrote {args.json}; load average {load}; total {time.perf_counter() - started:.0f} s")
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -455,6 +652,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--window", type=float, default=120.0, help="simulated seconds of the main comparison")
     parser.add_argument("--points", type=int, default=4, help="steps per explicit method's ladder")
     parser.add_argument("--no-sweep", action="store_true", help="skip the EA sweep")
+    parser.add_argument("--sweep-only", action="store_true", help="only the EA sweep (no MoorDyn, no WD0050 window)")
     parser.add_argument("--only", help="comma-separated ropesim methods to time (default: all; MoorDyn always)")
     parser.add_argument("--galpha-rho", type=float, default=0.0,
                         help="galpha's rho_inf (default 0, the setting for moorings; galpha's own default is 0.9)")
@@ -463,9 +661,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sweep-ea", default=",".join(f"{e:g}" for e in SWEEP_EA), help="EA values (N) to sweep")
     parser.add_argument("--json", type=Path, default=JSON, help="where the results go")
     parser.add_argument("--figure", type=Path, default=FIGURE, help="PNG of error against cost, and the sweep")
+    parser.add_argument("--fluid", nargs="?", const="current,towed,catenary", default=None,
+                        help="instead: galpha against MoorDyn on the equal-physics fluid cases (comma-separated)")
+    parser.add_argument("--fluid-window", type=float, default=20.0, help="--fluid: simulated seconds per case")
     args = parser.parse_args(argv)
     SEABED["both_ways"] = not args.own_seabed
     GALPHA["rho_inf"] = args.galpha_rho
+    if args.fluid:
+        if args.json == JSON:
+            args.json = JSON.with_name("moorings_fluid_speed.json")
+        return fluid_main(args)
 
     from references.moordyn_harness import moordyn_version
 
@@ -473,6 +678,8 @@ def main(argv: list[str] | None = None) -> int:
 
     started = time.perf_counter()
     print(f"MoorDyn {moordyn_version()}, ropesim {ropesim.__version__}", flush=True)
+    if args.sweep_only:
+        return sweep_main(args, started)
     case, start = problem()
     print(f"reference (rk4), {args.window:g} s ...", flush=True)
     ref, ref_info = reference(case, start, args.window)
@@ -492,16 +699,7 @@ def main(argv: list[str] | None = None) -> int:
     print("cost per force evaluation ...", flush=True)
     per_eval = term_costs(case, start, args.repeats)
 
-    sweep = []
-    if not args.no_sweep:
-        for EA in (float(e) for e in args.sweep_ea.split(",")):
-            print(f"EA = {EA:.0e} N, {SWEEP_WINDOW:g} s ...", flush=True)
-            c, s0 = problem(EA)
-            r, r_info = reference(c, s0, SWEEP_WINDOW)
-            cfg, n = configurations(c, s0, SWEEP_WINDOW, 4, moordyn=False)
-            sweep_rows = measure(c, s0, cfg, {"ropesim": r}, SWEEP_WINDOW, max(1, args.repeats - 1))
-            sweep.append({"EA": EA, "BA": c.BA, "reference": r_info, "notes": n, "rows": sweep_rows,
-                          "cheapest": cheapest(sweep_rows, TARGETS[:2])})
+    sweep = [] if args.no_sweep else stiff_sweep(args)
 
     try:
         load = os.getloadavg()

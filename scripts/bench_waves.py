@@ -21,10 +21,13 @@ window, relative to the reference's peak (and its RMS difference relative to the
 deviation); the speed is simulated seconds per CPU second of the run (one core; the least of ``--repeats`` runs
 of the window after compiling). ``--hours H`` then runs H hours of that sea whole, with the fastest candidate
 within 1 % (or with ``--step METHOD:DT``, skipping the ladder), and the cost per node-step of still water and
-1, 50, 200 components follows (rk4 at 1 ms, sdirk2 at 20 ms; ``--sweep-seconds`` long).
+1, 50, 200 components follows (rk4 at 1 ms, sdirk2 at 20 ms, galpha at 200 ms; ``--sweep-seconds`` long).
 
     python scripts/bench_waves.py --chain [--window 300] [--hours 3]
     python scripts/bench_waves.py --chain --step sdirk2:0.02 --hours 3 [--sweep-seconds 30]
+    python scripts/bench_waves.py --chain --methods galpha --hours 3 --no-sweep [--galpha-rho 0]
+
+galpha runs at ``--galpha-rho`` (default 0, the setting for a line read by its tension).
 """
 
 from __future__ import annotations
@@ -65,7 +68,10 @@ def evaluator(field: W.WaveField, nodes: int, direct: bool):
 
 CHAIN = Path(__file__).resolve().parent.parent / "scenarios" / "mooring_chain.toml"
 CANDIDATES = (("rk4", 0.001), ("rk4", 0.002), ("sdirk2", 0.01), ("sdirk2", 0.02), ("sdirk2", 0.04),
-              ("sdirk2", 0.05), ("sdirk2", 0.1))
+              ("sdirk2", 0.05), ("sdirk2", 0.1), ("galpha", 0.025), ("galpha", 0.05), ("galpha", 0.1),
+              ("galpha", 0.2))
+#: galpha's rho_inf here: 0, the setting for a line read by its tension (the accuracy page; --galpha-rho)
+GALPHA = {"rho_inf": 0.0}
 FRAME = 0.2   # s between compared frames: a whole number of every candidate's steps
 REFERENCE = ("rk4", 0.0005)
 TARGET = 0.01
@@ -88,6 +94,8 @@ def chain_in_a_sea(method: str, dt: float, t_end: float, components: int | None 
         scene["waves"] = {"kind": "jonswap", "significant_height": 6.0, "peak_period": 10.0,
                           "components": components, "ramp_time": 20.0}
     scene["integrator"] = {"method": method, "dt": dt, "t_end": t_end}
+    if method == "galpha":
+        scene["integrator"]["rho_inf"] = GALPHA["rho_inf"]
     scene["output"] = {"interval": FRAME}
     return ropesim.scene_from_toml(tomli_w.dumps(scene))
 
@@ -114,7 +122,7 @@ def fairlead_tension(scene, repeats: int = 1):
 
 
 def chain_target(window: float, repeats: int, hours: float, step: str | None = None,
-                 sweep_seconds: float = 30.0) -> None:
+                 sweep_seconds: float = 30.0, methods: tuple[str, ...] | None = None) -> None:
     console = Console()
     if step:   # a method and step chosen already: the whole sea and the cost per node-step, without the ladder
         method, dt = step.split(":")
@@ -124,11 +132,13 @@ def chain_target(window: float, repeats: int, hours: float, step: str | None = N
         console.print(f"{hours:g} h of the sea, whole, {method} at {1e3 * float(dt):g} ms: {cpu:.1f} s of CPU "
                       f"time, {t_end / cpu:.0f}x real time, {1e9 * cpu / (83 * t_end / float(dt)):.0f} ns per "
                       f"node-step, {per_step:.2f} force evaluations per step")
-        console.print(per_node_step(repeats, sweep_seconds))
+        if sweep_seconds > 0:
+            console.print(per_node_step(repeats, sweep_seconds))
         console.print(load_note())
         return
     fairlead_tension(chain_in_a_sea("rk4", 0.001, 1.0))         # compile both loops before timing
     fairlead_tension(chain_in_a_sea("sdirk2", 0.02, 1.0))
+    fairlead_tension(chain_in_a_sea("galpha", 0.1, 1.0))
     reference, ref_wall, _ = fairlead_tension(chain_in_a_sea(*REFERENCE, window))
     waves = reference[reference.size // 10:]
     table = Table(title=f"the mooring chain in a JONSWAP sea (Hs 6 m, Tp 10 s, 100 components), {window:g} s "
@@ -140,6 +150,8 @@ def chain_target(window: float, repeats: int, hours: float, step: str | None = N
     nodes = 83
     fastest = None
     for method, dt in CANDIDATES:
+        if methods and method not in methods:
+            continue
         try:
             tension, wall, per_step = fairlead_tension(chain_in_a_sea(method, dt, window), repeats)
         except Exception as exc:   # a step too long for the method blows up: say so and go on
@@ -161,16 +173,17 @@ def chain_target(window: float, repeats: int, hours: float, step: str | None = N
             t_end = 3600.0 * hours
             _, wall, _ = fairlead_tension(chain_in_a_sea(fastest[0], fastest[1], t_end))
             console.print(f"{hours:g} h of that sea, whole: {wall:.1f} s of CPU time, {t_end / wall:.0f}x real time")
-    console.print(per_node_step(repeats, sweep_seconds))
+    if sweep_seconds > 0:
+        console.print(per_node_step(repeats, sweep_seconds))
     console.print(load_note())
 
 
 def per_node_step(repeats: int, seconds: float = 30.0) -> Table:
-    """The whole step's cost per node [ns] on the chain, still water and 1, 50, 200 components, rk4 at 1 ms
-    and sdirk2 at 20 ms (runs interleaved, fastest of ``repeats``)."""
+    """The whole step's cost per node [ns] on the chain, still water and 1, 50, 200 components, rk4 at 1 ms,
+    sdirk2 at 20 ms and galpha at 200 ms (runs interleaved, fastest of ``repeats``)."""
     table = Table(title=f"the mooring chain under a sea, CPU ns per node-step (whole runs of {seconds:g} s)")
     table.add_column("waves", justify="right")
-    runs = {"rk4": 0.001, "sdirk2": 0.02}
+    runs = {"rk4": 0.001, "sdirk2": 0.02, "galpha": 0.2}
     for method, dt in runs.items():
         table.add_column(f"{method} at {1e3 * dt:g} ms", justify="right")
     counts = (None, 1, 50, 200)
@@ -196,9 +209,15 @@ def main() -> None:
     parser.add_argument("--hours", type=float, default=0.0, help="--chain: then run this many hours whole")
     parser.add_argument("--step", default=None, help="--chain: METHOD:DT, run --hours with it, no ladder")
     parser.add_argument("--sweep-seconds", type=float, default=30.0, help="--chain: the cost runs' length")
+    parser.add_argument("--galpha-rho", type=float, default=0.0, help="--chain: galpha's rho_inf (default 0)")
+    parser.add_argument("--no-sweep", action="store_true", help="--chain: skip the cost per node-step")
+    parser.add_argument("--methods", default=None, help="--chain: comma-separated methods of the ladder (default all)")
     args = parser.parse_args()
+    GALPHA["rho_inf"] = args.galpha_rho
     if args.chain:
-        chain_target(args.window, min(args.repeats, 2), args.hours, args.step, args.sweep_seconds)
+        chain_target(args.window, min(args.repeats, 2), args.hours, args.step,
+                     0.0 if args.no_sweep else args.sweep_seconds,
+                     tuple(args.methods.split(",")) if args.methods else None)
         return
     table = Table(title=f"wave kinematics, {args.nodes} nodes in 50 m of water (ns per node and evaluation)")
     for column in ("components", "recurrence", "direct", "direct / recurrence"):

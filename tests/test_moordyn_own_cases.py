@@ -321,6 +321,42 @@ def test_the_comparison_script_runs(tmp_path):
 
 
 @pytest.mark.slow
+def test_the_fluid_case_benchmark_runs(tmp_path):
+    """scripts/bench_moorings.py --fluid on the catenary's first 2 s (needs MoorDyn): both codes against their own
+    converged answers (which agree with their check runs), galpha's and MoorDyn's configurations timed, the
+    cheapest per accuracy in the JSON."""
+    pytest.importorskip("moordyn")
+    out = tmp_path / "fluid.json"
+    result = subprocess.run([sys.executable, str(ROOT / "scripts" / "bench_moorings.py"), "--fluid", "catenary",
+                             "--fluid-window", "2", "--repeats", "1", "--json", str(out)],
+                            capture_output=True, text=True, timeout=900)
+    assert result.returncode == 0, result.stderr
+    assert "| catenary (31 nodes, 2 s) | 1 % |" in result.stdout
+    case = json.loads(out.read_text())["cases"][0]
+    assert all(ref["check_rms_of_range"] < 1e-3 for ref in case["references"].values())
+    codes = {(row["code"], row["method"].split(" tol=")[0]) for row in case["rows"] if row["ok"]}
+    assert codes == {("ropesim", "galpha"), ("MoorDyn", "RK2"), ("MoorDyn", "RK4")}
+    assert set(case["cheapest"]) == {"0.01", "0.001"}
+
+
+@pytest.mark.slow
+def test_the_stiff_chain_sweep_runs_alone(tmp_path):
+    """scripts/bench_moorings.py --sweep-only at one EA with --only galpha: only galpha's configurations (fixed
+    and adaptive) are timed, against the EA's own rk4 reference, and its columns fill the sweep table."""
+    pytest.importorskip("moordyn")
+    out = tmp_path / "sweep.json"
+    result = subprocess.run([sys.executable, str(ROOT / "scripts" / "bench_moorings.py"), "--sweep-only",
+                             "--sweep-ea", "1e8", "--only", "galpha", "--repeats", "1", "--json", str(out)],
+                            capture_output=True, text=True, timeout=900)
+    assert result.returncode == 0, result.stderr
+    sweep = json.loads(out.read_text())["sweep"]
+    assert [s["EA"] for s in sweep] == [1e8]
+    assert {row["method"].split(" tol=")[0] for row in sweep[0]["rows"]} == {"galpha"}
+    assert {"ropesim galpha", "ropesim galpha adaptive"} <= set(sweep[0]["cheapest"]["0.01"])
+    assert "| 1e+08 | 1 % | — | — | — | " in result.stdout
+
+
+@pytest.mark.slow
 def test_the_speed_benchmark_runs(tmp_path):
     """scripts/bench_moorings.py on a 4 s window without the EA sweep (needs MoorDyn): every method timed against
     its code's converged answer, its tables, JSON and figure; MoorDyn's state set to ropesim's static shape."""

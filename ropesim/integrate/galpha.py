@@ -31,9 +31,10 @@ Without that, the stale block's few 1e-15 m of error a step, divided by beta_v i
 over many small steps (the tumbling tripod at 78 us: its angular velocity 1.1e-6 rad/s off after 0.1 s, 6e-8 with
 it, near a fresh matrix every step). A full update that raises the residual (a contact switching on, a segment going
 slack) is halved (a backtracking line search). The non-smooth terms are not regularised beyond what the force terms
-already do (the seabed's onset and the friction have their own smoothing lengths, see the seabed's docs), with one
-exception: MoorDyn's two-way seabed damping (``damping_both_ways``), a force that jumps by c A |v . n| at first
-contact, grows in over the seabed's delta_d for galpha (:mod:`ropesim.model.forces.seabed`); compressive geometric
+already do (the seabed's onset and the friction have their own smoothing lengths, see the seabed's docs), with two
+exceptions (:mod:`ropesim.model.forces.seabed`): MoorDyn's two-way seabed damping (``damping_both_ways``), a force
+that jumps by c A |v . n| at first contact, grows in over the seabed's delta_d for galpha; and ropesim's own
+one-way damping, which switches on and off at v . n = 0, does so smoothly over v_reg; compressive geometric
 stiffness is left out of the matrix as in SDIRK2.
 
 For a stiff line read by its tension (a mooring), rho_inf = 0 is the setting: af = 0, so the force balance is

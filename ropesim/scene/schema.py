@@ -130,7 +130,9 @@ class Seabed:
     A = contact_width x L (its share of unstretched length), plus the damping c |v_n| A while it moves into the
     plane (none while it moves out: the seabed is not sticky), grown in over the first 1e-3 footprint widths
     of depth (``damping_both_ways``: -c (v . n) A in both directions at full strength, as MoorDyn does); the
-    contact stiffness k and damping c per unit area are MoorDyn's kBot and cBot (its defaults). Sliding on it,
+    contact stiffness k and damping c per unit area are MoorDyn's kBot and cBot (its defaults). For the
+    ``galpha`` integrator's Newton solve the damping has no jump or kink: the two-way law grows in over the same
+    depth, and the one-way law's switch at rest is smoothed over ``friction_speed`` (the accuracy page). Sliding on it,
     the node feels Coulomb-like friction against its sliding velocity v_s (v minus its normal part), split along
     and across the rope (the node tangent projected on the plane):
 

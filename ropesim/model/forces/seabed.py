@@ -19,7 +19,11 @@ delta = -s. On its footprint A = contact_width x L (L its share of unstretched l
   Newton solve meets that jump at every landing and lift-off (c A |v . n|, 1.3 kN for WD0050's chain landing at
   0.1 m/s: at 0.1 s steps it failed at most touchdowns): there it grows in over the same delta_d,
   -c (v . n) A f (the regularisation; its effect on WD0050's fairlead tension is measured on the accuracy page,
-  "Moorings at the sea's time scale");
+  "Moorings at the sea's time scale"). ropesim's own law has a kink at rest instead, where the damping switches
+  on (v . n < 0) and off: a resting node's Newton iterates flipped between damped and free, and galpha failed
+  Newton at the thrown spar's second 0.1 s step. For galpha its min(v . n, 0) is C1 over v_reg
+  (``friction_speed``): -v_reg (2 u^2 - u^3), u = -v . n / v_reg, for -v_reg < v . n < 0 (:func:`inward`;
+  monotone, never pulling a node in; exact outside);
 - friction against its sliding velocity v_s = v - (v . n) n, split along the rope (the node tangent projected
   on the plane, t_s) and across it: F = -N (mu_axial (v_s . t_s) t_s + mu (v_s - (v_s . t_s) t_s)) /
   sqrt(|v_s|^2 + v_reg^2), N = k delta A the spring's normal load. Well above v_reg (``friction_speed``) this
@@ -29,7 +33,8 @@ delta = -s. On its footprint A = contact_width x L (L its share of unstretched l
 The damping and friction depend on velocity; their work is the energy ledger's ``seabed_work``.
 
 Parameters: ``seabed`` = (scalars [height, tan a, cos a, sin a, k, c, mu, mu_axial, v_reg, delta_d,
-both ways (1), both ways grown in over delta_d (2, galpha's) or into the plane only (0)], footprint (N,) [m^2]).
+both ways (1), both ways grown in over delta_d (2, galpha's), into the plane only (0) or so with its switch
+smoothed over v_reg (-1, galpha's)], footprint (N,) [m^2]).
 """
 
 from __future__ import annotations
@@ -52,6 +57,29 @@ DAMPING_DEPTH = 1e-3   # delta_d / the footprint's width: the depth over which t
 def depth(px, py, bed):
     """How far a point is sunk below the plane along its normal [m] (negative above it)."""
     return (bed[0] + bed[1] * px - py) * bed[2]
+
+
+@jit.kernel(inline="always")
+def inward(vn, scale):
+    """min(v_n, 0) made C1 over -scale < v_n < 0 [m/s]: -scale (2 u^2 - u^3), u = -v_n / scale, there (exact
+    outside, rising monotonically: slope u (4 - 3 u) in 0..4/3, 0 at rest); galpha's one-way damping switch."""
+    if vn >= 0.0:
+        return 0.0
+    if vn <= -scale:
+        return vn
+    u = -vn / scale
+    return -scale * u * u * (2.0 - u)
+
+
+@jit.kernel(inline="always")
+def inward_slope(vn, scale):
+    """d inward / d v_n."""
+    if vn >= 0.0:
+        return 0.0
+    if vn <= -scale:
+        return 1.0
+    u = -vn / scale
+    return u * (4.0 - 3.0 * u)
 
 
 @jit.kernel
@@ -86,6 +114,8 @@ def add_seabed_friction(x, v, acc, inv_mass, seabed, around):
             damp = c * area[i] * vn   # MoorDyn's: both ways, at full strength
             if bed[10] > 1.0:   # galpha's: both ways, grown in over delta_d
                 damp *= min(1.0, sunk / bed[9])
+        elif bed[10] < 0.0:   # galpha's: into the plane only, the switch at v . n = 0 smoothed over v_reg
+            damp = c * area[i] * min(1.0, sunk / bed[9]) * inward(vn, v_reg)
         else:
             damp = c * area[i] * min(1.0, sunk / bed[9]) * min(vn, 0.0)   # resists motion into the plane only
         fx = -damp * nx
@@ -152,6 +182,10 @@ def add_seabed_jacobian(x, v, band, beta, free, seabed, friction):
                 along_n -= beta * beta * bed[5] * area[i] * vn / bed[9]
         elif bed[10] > 0.0:
             along_n += beta * bed[5] * area[i]
+        elif bed[10] < 0.0:
+            along_n += beta * bed[5] * area[i] * min(1.0, sunk / bed[9]) * inward_slope(vn, bed[8])
+            if sunk < bed[9]:
+                along_n -= beta * beta * bed[5] * area[i] * inward(vn, bed[8]) / bed[9]
         elif vn < 0.0:
             along_n += beta * bed[5] * area[i] * min(1.0, sunk / bed[9])
             if sunk < bed[9]:
@@ -176,8 +210,9 @@ def _params(scene, layout) -> tuple:
     scalars = np.array([bed.height, math.tan(a), math.cos(a), math.sin(a), bed.stiffness, bed.damping, bed.friction,
                         bed.friction if bed.friction_axial is None else bed.friction_axial, bed.friction_speed,
                         DAMPING_DEPTH * float(width.max(initial=0.0)), 1.0 if bed.damping_both_ways else 0.0])
-    if bed.damping_both_ways and scene.integrator.method == "galpha":
-        scalars[10] = 2.0   # MoorDyn's law grown in over delta_d: a force without a jump for galpha's Newton solve
+    if scene.integrator.method == "galpha":   # forces without a jump or a kink in v . n for its Newton solve:
+        scalars[10] = 2.0 if bed.damping_both_ways else -1.0   # MoorDyn's law grown in over delta_d; the one-way
+        # law's switch at rest smoothed over v_reg
     return scalars, width * layout.node_length
 
 
