@@ -44,3 +44,19 @@ def pytest_configure(config):
         import compile_profile
 
         compile_profile.configure(config)
+
+
+# With -n, pytest-xdist hands out work by group (`--dist loadgroup`, pyproject.toml): a file is one group, as
+# `--dist loadfile` did (its module fixtures run once), except the files below, one group together. They run
+# every built-in scene's loop (the CLI's run folder, the bit-identity records, the MoorDyn imports of the same
+# terms): side by side on two workers both missed the cache and compiled the same loops (94 s of CPU twice in
+# one cold run); one after the other on one worker, the second loads what the first compiled.
+SHARED_LOOPS = {"test_bit_identity.py", "test_cli.py", "test_moordyn_import.py"}
+
+
+@pytest.hookimpl(tryfirst=True)   # before xdist's own hook, which reads the groups
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if not any(item.iter_markers("xdist_group")):
+            name = item.path.name
+            item.add_marker(pytest.mark.xdist_group("built-in-loops" if name in SHARED_LOOPS else name))
