@@ -52,11 +52,21 @@ def pytest_configure(config):
 # terms): side by side on two workers both missed the cache and compiled the same loops (94 s of CPU twice in
 # one cold run); one after the other on one worker, the second loads what the first compiled.
 SHARED_LOOPS = {"test_bit_identity.py", "test_cli.py", "test_moordyn_import.py"}
+# In the slow suite, `ropesim compile` of every built-in scene under every family (test_compile) and the loader's
+# rescaled fuzz (built-in scenes under random methods) ask for the same loops (32 of the fuzz's 34 pairs of method
+# and switches are a built-in scene's): one worker, one after the other, for the same reason.
+EVERY_FAMILY = {"test_compile.py", "test_loader.py"}
+
+
+def xdist_group(file_name: str) -> str:
+    """The xdist group of a test file's tests."""
+    if file_name in SHARED_LOOPS:
+        return "built-in-loops"
+    return "every-family" if file_name in EVERY_FAMILY else file_name
 
 
 @pytest.hookimpl(tryfirst=True)   # before xdist's own hook, which reads the groups
 def pytest_collection_modifyitems(config, items):
     for item in items:
         if not any(item.iter_markers("xdist_group")):
-            name = item.path.name
-            item.add_marker(pytest.mark.xdist_group("built-in-loops" if name in SHARED_LOOPS else name))
+            item.add_marker(pytest.mark.xdist_group(xdist_group(item.path.name)))
