@@ -68,6 +68,7 @@ def work_unit(file_name: str) -> str:
 
 
 if importlib.util.find_spec("xdist") is not None:
+    @pytest.hookimpl(optionalhook=True)   # xdist's hook: unknown to pytest when xdist is not loaded
     def pytest_xdist_make_scheduler(config, log):
         """`--dist loadfile`, with the files above sharing a unit (any other --dist: xdist's own)."""
         if config.getvalue("dist") != "loadfile":
