@@ -51,8 +51,8 @@ def pytest_configure(config):
 # run once), and here a few files together as one unit (pytest_xdist_make_scheduler below; xdist 3.8's own
 # `--dist loadgroup` groups nothing under pytest 9.2, whose node ids it can no longer suffix). The files in
 # SHARED_LOOPS run every built-in scene's loop (the CLI's run folder, the bit-identity records, the MoorDyn imports
-# of the same terms): side by side on two workers both missed the cache and compiled the same loops (112 s of CPU
-# twice in one cold run); one after the other on one worker, the second loads what the first compiled.
+# of the same terms): side by side on two workers both missed the cache and compiled the same loops (85-112 s of
+# CPU again in a cold run); one after the other on one worker, the second loads what the first compiled.
 SHARED_LOOPS = {"test_bit_identity.py", "test_cli.py", "test_moordyn_import.py"}
 # In the slow suite, `ropesim compile` of every built-in scene under every family (test_compile) and the loader's
 # rescaled fuzz (built-in scenes under random methods) ask for the same loops (32 of the fuzz's 34 pairs of method
