@@ -15,7 +15,10 @@ prints:
   compiled copies (:func:`ropesim.model.jit.specialise`; a family's loop for one set of terms) that no other
   test of the run asks for, with their compile seconds. Moving such a test to the slow suite, or giving it a
   term set other tests already compile, saves its ``own`` seconds; moving a test whose compiles other tests
-  also need only moves the bill to them (a compile is charged to the first test that needs the kernel).
+  also need only moves the bill to them (a compile is charged to the first test that needs the kernel);
+- the functions compiled again by another test, by the files involved: another signature, or two workers
+  that both missed the cache and compiled the same kernel side by side (``SHARED_LOOPS`` in
+  tests/conftest.py puts such files on one worker, one after the other).
 
 A kernel that is not a specialised copy (a helper, the static solver) is charged to the test that compiled it
 first and is never counted as ``own``.
@@ -79,6 +82,23 @@ def file_own_compiles(tests: dict[str, dict]) -> dict[str, float]:
     return out
 
 
+def repeated_compiles(tests: dict[str, dict]) -> dict[tuple, float]:
+    """Seconds spent compiling again a function that another test compiled too (outermost compiles beyond the
+    longest one of each name), by the files whose tests compiled it. Either another signature of the same
+    function, or, across two workers, the same kernel compiled side by side, both having missed the cache (the
+    files to run one after the other on one worker: ``SHARED_LOOPS`` in tests/conftest.py)."""
+    by_name: dict[str, list] = defaultdict(list)
+    for nodeid, test in tests.items():
+        for name, seconds, depth in test["compiles"]:
+            if depth == 0:
+                by_name[name].append((seconds, nodeid.split("::")[0]))
+    out: dict[tuple, float] = defaultdict(float)
+    for rows in by_name.values():
+        if len(rows) > 1:
+            out[tuple(sorted({file for _, file in rows}))] += sum(s for s, _ in rows) - max(s for s, _ in rows)
+    return dict(out)
+
+
 def outermost(rows: list) -> float:
     """The seconds of ``rows`` (compiles) counted once: a callee compiled inside its caller (depth 1 and more)
     is in its caller's seconds. (A copy only one test needs is called only by copies only that test needs.)"""
@@ -117,6 +137,11 @@ def table(tests: dict[str, dict], top: int) -> str:
     for nodeid, t in ranked:
         lines.append(f"{t['cpu']:7.1f} {t['compile_cpu'] + t['child_compile_cpu']:7.1f} {t['children']:7.1f} "
                      f"{len(t['compiles']):8d} {outermost(own[nodeid]):6.1f}  {nodeid}")
+
+    repeated = repeated_compiles(tests)
+    lines += ["", f"compiled again by another test: {sum(repeated.values()):.0f} s (seconds beyond the first, "
+              "by the files that compiled it)"]
+    lines += [f"{s:7.1f}  {' + '.join(files)}" for files, s in sorted(repeated.items(), key=lambda kv: -kv[1])]
 
     lines += ["", "copies only one test needs (seconds to compile, copy, test)"]
     rows = sorted(((s, name, nodeid) for nodeid, r in own.items() for name, s, depth in r if depth == 0),

@@ -30,6 +30,9 @@ def example(tmp_path_factory):
     return module
 
 
+# slow: the coupled spar's splitting loop is compiled for this example alone (6 s of a cold run); the coupling's
+# own checks stay quick (tests/test_coupling.py)
+@pytest.mark.slow
 def test_the_coupled_spar_converges_to_the_free_one_at_first_order_in_the_coupling_step(example):
     reference = example.free_body(30.0)
     moved = np.max(np.linalg.norm(reference[1] - reference[1][0], axis=1))

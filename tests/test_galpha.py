@@ -77,6 +77,9 @@ def test_without_numerical_dissipation_an_undamped_chain_keeps_its_energy_at_sec
     assert np.all(np.abs(slopes - 2.0) < 0.1), (peaks, slopes)
 
 
+# slow: galpha's loop of a free point between two lines is compiled for this test alone (10 s of a cold quick run);
+# galpha on a system stays quick in tests/test_galpha_bodies.py (the tripod's body on three lines)
+@pytest.mark.slow
 def test_on_a_system_the_free_point_moves_as_one_and_the_order_is_two():
     """The clump weight on two wires (a free point joining two lines, solved by the Schur complement), the wires
     taking compression (a smooth problem): galpha at dt = 1, 0.5, 0.25 ms against rk4 at 10 us converges at
@@ -110,6 +113,8 @@ def test_the_fitted_order_on_the_seeds_scenes_is_two_within_five_hundredths(name
         assert order == pytest.approx(2.0, abs=0.05), (rho, errors)
 
 
+# slow: galpha's loop of mooring_chain is compiled for this test alone (8 s of a cold quick run)
+@pytest.mark.slow
 def test_mooring_chain_at_a_tenth_of_a_second():
     """mooring_chain (seabed contact and friction, fluid drag, added mass, a surging fairlead) at dt = 0.1 s, 40
     times rk4's stable step: Newton converges at every step, to 30 s (about 10 iterations and 2.5

@@ -8,6 +8,7 @@ below the errors fitted); sdirk2's tests (tests/test_sdirk_bodies.py) for the sc
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import replace
 
@@ -121,6 +122,12 @@ def errors_against(scene, reference, steps, t_end: float, **keys) -> list[tuple[
     return out
 
 
+@functools.cache
+def tripod_reference():
+    """The tumbling tripod run by rk4 at 10 us to 0.1 s: the reference of the tests below (computed once)."""
+    return advance(scene_from_toml(tumbling_tripod()), "rk4", 1e-5, 0.1)
+
+
 def test_galpha_on_a_tumbling_body_on_lines_converges_at_second_order_and_agrees_with_verlet():
     """The tripod of tests/test_sdirk_bodies.py (a 500 kg body, thrown and spinning on three elastic lines), to
     0.1 s, against rk4 at 10 us (verlet at 10 us is 2e-11 m from it on the body, 2e-9 m on the nodes): errors
@@ -128,8 +135,7 @@ def test_galpha_on_a_tumbling_body_on_lines_converges_at_second_order_and_agrees
     3.8e-9, 9.5e-10 m, its quaternion 2.2e-8, 5.6e-9, 1.3e-9), each halving of dt dividing them by 4.0 (asserted
     above 3.6; the quaternion's above 3.5). At 78 us the body agrees with verlet within 2e-9 m and 2e-9 in its
     quaternion, a unit one to round-off."""
-    scene = scene_from_toml(tumbling_tripod())
-    reference = advance(scene, "rk4", 1e-5, 0.1)
+    scene, reference = scene_from_toml(tumbling_tripod()), tripod_reference()
     errors = errors_against(scene, reference, (3.125e-4, 1.5625e-4, 7.8125e-5), 0.1)
     for k in range(2):
         assert errors[k][0] / errors[k + 1][0] > 3.6, errors
@@ -154,8 +160,7 @@ def test_the_tolerance_covers_the_bodies(tol):
     """Adaptive steps on the tumbling tripod to 0.1 s (reported every 10 ms): the true error (body and nodes,
     against rk4 at 10 us) is within the tolerance (measured 0.57, 0.67, 0.69 of it at 1e-3, 1e-4, 1e-5 m) and
     the steps shrink with it (29, 91, 286 steps)."""
-    scene = scene_from_toml(tumbling_tripod())
-    reference = advance(scene, "rk4", 1e-5, 0.1)
+    scene, reference = scene_from_toml(tumbling_tripod()), tripod_reference()
     it = advance(scene, "galpha", 0.01, 0.1, tolerance=tol)
     error = max(np.abs(it.pose[:3] - reference.pose[:3]).max(), np.abs(it.x - reference.x).max())
     assert 0.1 * tol < error < tol, error

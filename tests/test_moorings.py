@@ -178,6 +178,9 @@ def test_a_cantilevers_static_tip_deflection_converges_to_euler_bernoulli():
     assert 3.0 < errors[0] / errors[1] < 5.0 and 3.0 < errors[1] / errors[2] < 5.0, errors
 
 
+# slow: an sdirk2 loop of a bent beam no other quick test compiles (6 s of a cold run); the beam's static
+# deflection stays quick (above), its release against MoorDyn too (tests/test_moordyn_own_cases.py)
+@pytest.mark.slow
 def test_a_cantilever_released_straight_swings_at_its_first_euler_bernoulli_frequency():
     """Released straight, the beam oscillates about its static shape mostly in its first mode: the tip's
     period from zero crossings of its offset from the static deflection, against 2 pi / omega_1 with

@@ -246,8 +246,10 @@ def test_sea_and_waves_keys_refused_with_one_line(tmp_path):
             assert "no 'direction' column" in lines[0]
 
 
+# slow, every case: each is a loop of a scene with a [sea] above it that no other test compiles (buoy_tether's
+# sdirk2 with the sea: 19 s of a cold quick run); the sea's forces per node stay quick (below)
 @pytest.mark.parametrize("name, sets", [
-    ("buoy_tether", ["integrator.t_end=10.0", "output.interval=1.0"]),
+    pytest.param("buoy_tether", ["integrator.t_end=10.0", "output.interval=1.0"], marks=pytest.mark.slow),
     pytest.param("buoy_tether", ["integrator.method=rk4", "integrator.dt=5e-4", "integrator.t_end=2.0",
                                  "output.interval=0.5"], marks=pytest.mark.slow),
     pytest.param("spread_mooring", ["integrator.t_end=10.0", "output.interval=1.0"], marks=pytest.mark.slow),

@@ -62,6 +62,8 @@ def test_the_hose_heaves_with_the_surface_at_long_periods_and_the_probes_hold_ai
     assert rope.submerged.shape == (len(run.t), 31)
 
 
+# slow: its held-fairlead chain in waves is a loop no other quick test compiles (7 s of a cold run)
+@pytest.mark.slow
 def test_the_chain_fairlead_tension_range_grows_with_hs():
     """Only the waves load the chain (its fairlead held): the fairlead tension's swing about its mean grows with
     Hs (drag, quadratic in the orbital velocity, and the inertia force, linear: between 2 and 4 times from 3 m to

@@ -54,3 +54,13 @@ def test_the_table_sums_workers_and_subprocesses(tmp_path):
     assert rows["tests/test_a.py"] == ["15.0", "12.0", "0.0", "3", "8.0", "8.0"]
     assert rows["tests/test_c.py"] == ["1.0", "2.5", "3.0", "1", "0.0", "0.0"]
     assert "    8.0  m.loop__s3  tests/test_a.py::a" in text.splitlines()
+
+
+def test_a_function_compiled_by_two_tests_counts_beyond_the_first(tmp_path):
+    _write(tmp_path)
+    tests = suite_profile.load(tmp_path)
+    assert suite_profile.repeated_compiles(tests) == {}
+    tests["tests/test_c.py::c"]["compiles"].append([SHARED, 3.0, 0])   # c compiled b's loop as well
+    tests["tests/test_c.py::c"]["compiles"].append([TERM, 1.0, 1])     # inside it: not counted again
+    assert suite_profile.repeated_compiles(tests) == {("tests/test_a.py", "tests/test_c.py"): 3.0}
+    assert "    3.0  tests/test_a.py + tests/test_c.py" in suite_profile.table(tests, top=2).splitlines()

@@ -210,6 +210,9 @@ def test_sdirk2_on_the_clump_weight_converges_at_second_order():
     assert np.abs(advance(scene, "sdirk2", 1.25e-4, 0.5).x - verlet).max() < 2.5e-5
 
 
+# slow: a 3-D sdirk2 loop of a free point with every fluid term that no other quick test compiles (12 s of a cold
+# run); sdirk2 on a system stays quick with the clump weight above.
+@pytest.mark.slow
 def test_three_line_spread_in_water_sdirk2_against_rk4_and_the_point_holds_together():
     """The 3-D three-line spread (lines starting and ending on the point, so both factorisation directions of
     the lines run) under water: buoyancy, Morison drag and added mass on the lines and on the point (its own
