@@ -120,7 +120,7 @@ def _g(u):
     return (u * math.acos(-u) + math.sqrt(w) - w * math.sqrt(w) / 3.0) / math.pi
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def cylinder_fraction(y_node, y_mid, rc, surface):
     """(fraction, its derivative by y_node) of a half segment's cylinder below the plane y = ``surface``: the
     cylinder's axis from height ``y_node`` (the node) to ``y_mid`` (its segment's middle, which moves half as
@@ -151,7 +151,7 @@ def _half_piece(x, i, j, surface, r):
     return cylinder_fraction(x[1, i], x[1, i] + dy, rc, surface)
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def line_fraction(x, i, around, surface, nodes):
     """(f, df/dy_i) of node i's share of its line below ``surface`` (module doc); (1, 0) on a node without a line
     volume."""
