@@ -70,6 +70,9 @@ CASES = {   # name: (scene, --set, method, steps per timed call, timed calls)
     # sdirk2: 11 calls of 400 steps stay inside the 4.86 s its Newton solve survives the box's sharp edges
     **{f"shooter_high {m}": (f"{SCEN}/shooter_high.toml", [], m, 400 if m == "sdirk2" else 20_000, 9)
        for m in ("symplectic_euler", "verlet", "yoshida4", "pefrl", "rk4", "sdirk2")},
+    # the sea's scenes: the free surface's fractions, the waves' kinematics, the Newton matrix's sea blocks
+    "mooring_chain_waves sdirk2": (f"{SCEN}/mooring_chain_waves.toml", [], "sdirk2", 400, 9),
+    "floating_hose sdirk2": (f"{SCEN}/floating_hose.toml", [], "sdirk2", 1_000, 9),
 }
 
 

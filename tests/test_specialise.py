@@ -215,3 +215,39 @@ def test_the_bytecode_scan_finds_the_globals_dis_finds_in_every_kernel():
                 assert jit._globals_read(value.py_func) == want, value.py_func.__qualname__
                 checked += 1
     assert checked > 80
+
+
+SEA_PROBE = """
+import json
+import numpy as np
+import ropesim
+from ropesim.model.build import build
+from ropesim.model.forces.sea import water_state
+
+model = build(ropesim.load_scene(SCENE), solve=False)
+model.kernel(water_state)(np.ascontiguousarray(model.x0), model.params, 0.5)
+print(json.dumps([jit_name for jit_name in compiled]))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scene, used, unused", [
+    ("floating_hose", "direct_kinematics", "recurrence_kinematics"),          # a regular wave
+    ("mooring_chain_waves", "recurrence_kinematics", "direct_kinematics"),    # a JONSWAP spectrum
+])
+def test_the_sea_compiles_only_the_wave_evaluation_its_waves_take(tmp_path, scene, used, unused):
+    names = [jit.template_name(n) for n in _probe(SEA_PROBE.replace("SCENE", repr(scene)), tmp_path / "cache")]
+    assert f"ropesim.model.waves.{used}" in names, names
+    assert f"ropesim.model.waves.{unused}" not in names, names
+    assert ("ropesim.model.waves.water_at" in names) == (used == "direct_kinematics"), names
+
+
+def test_the_seas_switches_follow_its_waves_and_fraction_rule():
+    import ropesim
+    from ropesim.model.terms import switches
+
+    hose = switches(ropesim.load_scene("floating_hose"))
+    assert {"sea", "waves"} <= hose and not {"wave_recurrence", "moordyn_fraction"} & hose
+    chain = switches(ropesim.load_scene("mooring_chain_waves", ['sea.fraction="moordyn"']))
+    assert {"sea", "waves", "wave_recurrence", "moordyn_fraction"} <= chain
+    assert not {"waves", "wave_recurrence", "moordyn_fraction"} & switches(ropesim.load_scene("mooring_chain"))

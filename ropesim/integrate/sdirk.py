@@ -108,8 +108,12 @@ bodies' stage state (:class:`~ropesim.integrate.sdirk_bodies.BodyStage`); None f
 Stage = namedtuple("Stage", ["xh", "vh", "X", "V", "acc", "acc_box", "tmp"])
 """A stage's known part (xh, vh), its unknowns (X, V), the accelerations there and scratch, all (D, N)."""
 
-Nodes = namedtuple("Nodes", ["free", "mass", "drag"])
-"""Per node: free (not held), mass [kg], linear drag b [kg/s] (0 at held nodes)."""
+
+def node_arrays(model) -> tuple:
+    """Per node: (free (not held), mass [kg], linear drag b [kg/s], 0 at held nodes). A plain tuple, the type the
+    static solver hands :func:`~ropesim.model.terms.newton_matrix` too: a scene with a static start then compiles
+    the Newton matrix once, for both (a named tuple is another type to Numba, and compiled it again)."""
+    return np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag)
 
 
 class SdirkFamily(Integrator):
@@ -131,7 +135,7 @@ class SdirkFamily(Integrator):
         self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, tol, np.zeros(nt), groups, body)
         shape = (dim, n)
         self.stage = Stage(*(np.zeros(shape) for _ in Stage._fields))
-        self.nodes = Nodes(np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag))
+        self.nodes = node_arrays(model)
         self.stats = np.zeros(1, dtype=np.int64)
 
     @staticmethod

@@ -10,8 +10,9 @@ calls) with the undeclared terms' branches removed before Numba types them. An u
 empty parameters of the same types, so the bundle has one layout for every scene.
 
 Besides one switch per optional term there are two derived from the term records (:data:`WITH_VELOCITY_TERMS`,
-:data:`WITH_APPLIED`), :data:`~ropesim.model.banded.WITH_WRAP_AROUND` for a closed loop's Newton matrix, and
-:data:`WITH_MOTION` for held nodes with a prescribed motion.
+:data:`WITH_APPLIED`), :data:`~ropesim.model.banded.WITH_WRAP_AROUND` for a closed loop's Newton matrix,
+:data:`WITH_MOTION` for held nodes with a prescribed motion, and a sea's own (its waves, the evaluation they take,
+the lines' fraction rule: :func:`ropesim.model.forces.sea.sea_switches`).
 
 Compiled entry points, each the term list in one form:
 
@@ -40,7 +41,7 @@ from .forces.fluid import (BODY_DRAG_TERM, FLOW_PUSH_TERM, FLOW_TERM, FLUID_DRAG
                            WITH_BODY_DRAG, WITH_FLOW_PUSH, WITH_FLUID_DRAG, WITH_VISCOUS_DRAG, add_fluid_forces,
                            add_fluid_jacobian)
 from .forces.flow_inertia import FLOW_INERTIA_TERM, WITH_FLOW_INERTIA, add_flow_inertia
-from .forces.sea import SEA_TERM, WITH_SEA, WITH_WAVES, add_sea_drag, add_sea_forces, add_sea_jacobian, water_state
+from .forces.sea import SEA_TERM, WITH_SEA, add_sea_drag, add_sea_forces, add_sea_jacobian, sea_switches, water_state
 from .forces.gravity import GRAVITY as GRAVITY_TERM
 from .forces.gravity import WITH_GRAVITY
 from .forces.guides import GUIDES as GUIDES_TERM
@@ -112,14 +113,14 @@ def declared_terms(scene) -> tuple:
 
 def switches(scene) -> jit.Switches:
     """The compile-time switches of ``scene``'s terms: each declared term's, the two derived from their
-    records (velocity-dependent terms, terms booked as box work), and a closed loop's wrap-around in the
-    Newton matrix. :data:`WITH_MOTION` is the model's to add."""
+    records (velocity-dependent terms, terms booked as box work), a closed loop's wrap-around in the Newton
+    matrix, and a sea's own. :data:`WITH_MOTION` is the model's to add."""
     declared = declared_terms(scene)
     on = {term.switch.name for term in declared if term.switch is not None}
     if any(line.closed for line in line_layouts(scene)):
         on.add(WITH_WRAP_AROUND.name)
-    if WITH_SEA.name in on and scene.waves is not None:
-        on.add(WITH_WAVES.name)
+    if WITH_SEA.name in on:
+        on |= sea_switches(scene)
     if junctions(scene):
         on.add(WITH_JUNCTIONS.name)
     if free_bodies(scene):

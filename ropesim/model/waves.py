@@ -331,6 +331,13 @@ def orbital_speed(field: WaveField) -> float:
     return float(min(speed.sum(), 4.0 * math.sqrt(0.5 * float((speed * speed).sum()))))
 
 
+def recurrence(components: Components) -> bool:
+    """Whether the compiled kernels evaluate ``components`` by the recurrence (a spectrum's evenly spaced wave
+    numbers, one direction) rather than each component directly (module doc)."""
+    c = components
+    return c.spacing is not None and c.count > 0 and bool(np.all(c.direction == c.direction[0]))
+
+
 def compiled_tables(field: WaveField) -> tuple[np.ndarray, np.ndarray]:
     """The compiled kernels' tables of ``field``: its scalars (WAVE_SCALARS,) and its components (COMP_ROWS, J)
     (module doc). A spectrum's evenly spaced wave numbers select the recurrence, any other set direct
@@ -340,7 +347,7 @@ def compiled_tables(field: WaveField) -> tuple[np.ndarray, np.ndarray]:
     out[LEVEL], out[DEPTH], out[GRAVITY] = field.level, field.depth, field.g
     out[RAMP_TIME] = field.ramp_time
     out[STRETCHING] = STRETCHINGS[field.stretching]
-    uniform = c.spacing is not None and c.count > 0 and bool(np.all(c.direction == c.direction[0]))
+    uniform = recurrence(c)
     out[MODE] = RECURRENCE if uniform else DIRECT
     k = c.k
     if uniform:
@@ -435,21 +442,37 @@ NODE_ROWS = 13
 def node_kinematics(x, t, scalars, comps, work, out):
     """The waves at every node of ``x`` (D, N) at time t [s] into ``out`` (7, N): rows eta, u (3), a (3), as
     :func:`water_at` gives them for one point; ``work`` (NODE_ROWS, N) is scratch. A spectrum's evenly spaced
-    wave numbers (scalars' MODE) take the recurrence of the module doc, vectorised over the nodes: per node two
-    sines, two cosines and four exponentials, per node and component a complex multiplication."""
-    dim, n = x.shape
+    wave numbers (scalars' MODE) take the recurrence (:func:`recurrence_kinematics`), any other set each
+    component directly (:func:`direct_kinematics`). The free surface's kernel calls the one its scene's waves
+    take (compiling only that one); this one chooses at run time."""
     if scalars[MODE] != RECURRENCE:
-        for i in range(n):
-            z = x[2, i] if dim == 3 else 0.0
-            e, u0, u1, u2, a0, a1, a2 = water_at(x[0, i], x[1, i], z, t, scalars, comps)
-            out[0, i] = e
-            out[1, i] = u0
-            out[2, i] = u1
-            out[3, i] = u2
-            out[4, i] = a0
-            out[5, i] = a1
-            out[6, i] = a2
-        return
+        direct_kinematics(x, t, scalars, comps, out)
+    else:
+        recurrence_kinematics(x, t, scalars, comps, work, out)
+
+
+@jit.kernel
+def direct_kinematics(x, t, scalars, comps, out):
+    """:func:`node_kinematics` with each component evaluated directly, node by node (:func:`water_at`)."""
+    dim, n = x.shape
+    for i in range(n):
+        z = x[2, i] if dim == 3 else 0.0
+        e, u0, u1, u2, a0, a1, a2 = water_at(x[0, i], x[1, i], z, t, scalars, comps)
+        out[0, i] = e
+        out[1, i] = u0
+        out[2, i] = u1
+        out[3, i] = u2
+        out[4, i] = a0
+        out[5, i] = a1
+        out[6, i] = a2
+
+
+@jit.kernel
+def recurrence_kinematics(x, t, scalars, comps, work, out):
+    """:func:`node_kinematics` for a spectrum's evenly spaced wave numbers: the recurrence of the module doc,
+    vectorised over the nodes: per node two sines, two cosines and four exponentials, per node and component a
+    complex multiplication."""
+    dim, n = x.shape
     time_factors(scalars, comps, t)
     k0, dk, d = scalars[K0], scalars[DK], scalars[DEPTH]
     cb, sb = scalars[DIR_COS], scalars[DIR_SIN]

@@ -74,11 +74,16 @@ from .fluid import (WITH_BODY_DRAG, WITH_FLOW, WITH_FLUID_DRAG, flow_at, flow_sc
 from ..ramp import ramp_rate
 from ..junctions import WITH_JUNCTIONS
 from ..layout import junctions, line_volumes, lumped_bodies, per_node
-from ..waves import (COMP_ROWS, LEVEL, NODE_ROWS, WAVE_SCALARS, compiled_tables, node_kinematics, wave_field)
+from ..waves import (COMP_ROWS, LEVEL, NODE_ROWS, WAVE_SCALARS, compiled_tables, direct_kinematics,
+                     recurrence, recurrence_kinematics, wave_field)
 from .. import jit
 
 WITH_SEA = jit.Switch("sea", "a free surface: water below, air above")
 WITH_WAVES = jit.Switch("waves", "waves on the sea")
+WITH_WAVE_RECURRENCE = jit.Switch("wave_recurrence", "a spectrum's waves: their kinematics by the recurrence over "
+                                                     "evenly spaced wave numbers (ropesim.model.waves)")
+WITH_MOORDYN_FRACTION = jit.Switch("moordyn_fraction", "[sea] fraction = \"moordyn\": MoorDyn 2's submerged "
+                                                       "fraction of the lines")
 
 Sea = namedtuple("Sea", ["scalars", "comps", "nodes"])
 
@@ -120,7 +125,7 @@ def _g(u):
     return (u * math.acos(-u) + math.sqrt(w) - w * math.sqrt(w) / 3.0) / math.pi
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def cylinder_fraction(y_node, y_mid, rc, surface):
     """(fraction, its derivative by y_node) of a half segment's cylinder below the plane y = ``surface``: the
     cylinder's axis from height ``y_node`` (the node) to ``y_mid`` (its segment's middle, which moves half as
@@ -151,7 +156,7 @@ def _half_piece(x, i, j, surface, r):
     return cylinder_fraction(x[1, i], x[1, i] + dy, rc, surface)
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def line_fraction(x, i, around, surface, nodes):
     """(f, df/dy_i) of node i's share of its line below ``surface`` (module doc); (1, 0) on a node without a line
     volume."""
@@ -260,8 +265,11 @@ def water_state(x, p, t):
         for r in range(7):
             for i in range(n):
                 nodes[ETA + r, i] = nodes[GIVEN + r, i]
-    elif WITH_WAVES:
-        node_kinematics(x, t, scalars, sea.comps, nodes[WORK:WORK + NODE_ROWS], nodes[ETA:AZ + 1])
+    elif WITH_WAVES:   # only the evaluation the scene's waves take is compiled
+        if WITH_WAVE_RECURRENCE:
+            recurrence_kinematics(x, t, scalars, sea.comps, nodes[WORK:WORK + NODE_ROWS], nodes[ETA:AZ + 1])
+        else:
+            direct_kinematics(x, t, scalars, sea.comps, nodes[ETA:AZ + 1])
     else:
         for r in range(ETA, AZ + 1):
             for i in range(n):
@@ -280,10 +288,9 @@ def water_state(x, p, t):
                 nodes[AY, i] += a1
                 nodes[AZ, i] += a2
     level = scalars[LEVEL]
-    moordyn = scalars[FRACTION_RULE] == MOORDYN_RULE
     for i in range(n):
         surface = level + nodes[ETA, i]
-        if moordyn:
+        if WITH_MOORDYN_FRACTION:
             nodes[F_LINE, i] = moordyn_line_fraction(x, i, p.neighbours, level, nodes)
         else:
             nodes[F_LINE, i] = line_fraction(x, i, p.neighbours, surface, nodes)[0]
@@ -491,6 +498,20 @@ def sea_nodes(scene, layout) -> np.ndarray:
             nodes[HALF_LO, line.first] = 0.0
             nodes[HALF_HI, line.end - 1] = 0.0
     return nodes
+
+
+def sea_switches(scene) -> set[str]:
+    """The switches of a scene's sea beyond :data:`WITH_SEA`: its waves, the evaluation they take and the
+    lines' fraction rule (none without ``[sea]``)."""
+    if scene.sea is None:
+        return set()
+    on = {WITH_MOORDYN_FRACTION.name} if scene.sea.fraction == "moordyn" else set()
+    field = wave_field(scene)
+    if field is not None:
+        on.add(WITH_WAVES.name)
+        if recurrence(field.components):
+            on.add(WITH_WAVE_RECURRENCE.name)
+    return on
 
 
 def _params(scene, layout) -> Sea:
