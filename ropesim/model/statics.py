@@ -145,7 +145,6 @@ def _solve(model, x: np.ndarray | None, tol: float, max_iterations: int, pose: n
     nt, m = dim * n, w * dim
     jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
     wood = woodbury(nt, m)
-    groups = model_groups(model, w)
     nodes = (free, mass, np.where(model.held, 0.0, model.drag))
     dragged = {WITH_FLUID_DRAG.name, WITH_VISCOUS_DRAG.name} & model.switches
     if not differenced or (cyclic and n < 2 * w + 1):
@@ -154,6 +153,7 @@ def _solve(model, x: np.ndarray | None, tol: float, max_iterations: int, pose: n
     else:   # an explicit method's loop compiles no Newton matrix: differenced from the loop's own force
         differenced = DifferencedMatrix(model, acceleration, w, cyclic, free, mass, nodes[2], t,
                                         model.velocity_dependent)
+    groups = model_groups(model, w, arms=differenced is None)   # else placed by StaticBodies, in NumPy
     bodies = StaticBodies(model, groups, t, differenced is None) if p.bodies is not None else None
     junctions = p.junctions
     if groups.nodes.size:   # a system's free points and bodies: each line banded, they by a Schur complement
