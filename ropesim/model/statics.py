@@ -27,7 +27,8 @@ taken when it halves the residual. The banded solves make each iteration O(N).
 
 A system of lines is solved the same way: a free point's line ends share one unknown and its balance is the sum
 of the forces on them (:func:`~ropesim.model.junctions.fold_junctions`), the step solved with each line banded
-and the points' unknowns by a Schur complement (:mod:`ropesim.model.schur`). The pseudo-time step starts at the
+and the points' unknowns by a Schur complement (:mod:`ropesim.model.schur`; for an explicit method, whose loop
+compiles none, in NumPy around the banded factor and solve, :mod:`ropesim.model.static_schur`). The pseudo-time step starts at the
 stiffest line's spring period, and no node moves more than the shortest segment in one step.
 
 A free rigid body's unknowns are its reference point's displacement and a small rotation vector (six in 3-D,
