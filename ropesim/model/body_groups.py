@@ -22,7 +22,8 @@ import numpy as np
 from . import jit
 from .bodies import body_own_system
 from .body_layout import ARM
-from .body_sea import heave_stiffness
+from .body_sea import WITH_BODY_SEA, heave_stiffness
+from .forces.fluid import WITH_FLOW, flow_at
 from .forces.gravity import WITH_GRAVITY
 from .rotation import matrix_of, rotate
 
@@ -107,10 +108,13 @@ class StaticBodies:
     reference point, its own block of the step's matrix (its mass matrix plus tau^2 its rotational geometric
     stiffness) and its own right-hand side, its potential energy, and its pose moved by a step."""
 
-    def __init__(self, model, groups, t: float):
+    def __init__(self, model, groups, t: float, compiled: bool = True):
         from .bodies import place_attachments
 
         self.model, self.groups, self.t = model, groups, t
+        # compiled False (an explicit method's static start): the bodies' own parts at rest in NumPy
+        # (:meth:`own_numpy`), their attachments placed in NumPy, unless the sea's loads act on them
+        self.compiled = compiled or WITH_BODY_SEA.name in model.switches
         self.bundle = bundle = model.params.bodies
         self.dim = model.dim
         self.count = bundle.mass.size
@@ -118,7 +122,7 @@ class StaticBodies:
         self.k = body_unknowns(self.dim)
         self.first = groups.nodes.size - bundle.nodes.size                 # the bodies' members come last
         self.offset = int(groups.offset[-1]) - self.count * self.k         # ... and so do their unknowns
-        self.own = model.kernel(own_parts)
+        self.own = model.kernel(own_parts) if self.compiled else None
         self.place_nodes = place_attachments
         self.work = np.zeros((self.count, 6, 7))
         self.still = np.zeros((6, self.count))
@@ -135,8 +139,43 @@ class StaticBodies:
     def place(self, x: np.ndarray, pose: np.ndarray) -> None:
         """Put the attachment nodes of ``x`` (D, N) where the bodies at ``pose`` hold them, and their arms into
         the groups."""
-        self.place_nodes(x, np.zeros_like(x), self.bundle, pose, self.still)
-        set_body_arms(self.groups.arm, self.first, self.bundle, pose)
+        if self.compiled:
+            self.place_nodes(x, np.zeros_like(x), self.bundle, pose, self.still)
+            set_body_arms(self.groups.arm, self.first, self.bundle, pose)
+            return
+        bundle, turned = self.bundle, _matrices(pose[3:7])
+        for b in range(self.count):
+            members = slice(bundle.start[b], bundle.start[b + 1])
+            arms = turned[b] @ bundle.arm[:, members]                  # rho_c = R s_c
+            self.groups.arm[:, self.first + members.start:self.first + members.stop] = arms
+            x[:, bundle.nodes[members]] = (pose[:3, b, None] + arms)[:self.dim]
+
+    def own_numpy(self, pose: np.ndarray) -> None:
+        """What :func:`own_parts` puts into ``work`` for bodies at rest (no twist: no centripetal force, gyroscopic
+        moment, rotational drag or damper's force) out of a sea: the mass matrix at the centre of gravity with the
+        inertia and added mass, turned into world axes; the weight at the centre of gravity, the buoyancy at the
+        centre of buoyancy, the flow's drag on the reference point (per body axis C_i |u| u_i, u the flow there)
+        and the linear spring."""
+        from .bodies import constant_mass
+
+        bundle, p, t = self.bundle, self.model.params, self.t
+        turned = _matrices(pose[3:7])
+        flowing = WITH_FLOW.name in self.model.switches
+        for b in range(self.count):
+            r = turned[b]
+            spin = np.zeros((6, 6))
+            spin[:3, :3] = spin[3:, 3:] = r
+            own = constant_mass(bundle.mass[b], bundle.cog[:, b], bundle.inertia[:, :, b], bundle.added[:, b],
+                                bundle.added_rot[:, b], (), np.zeros((3, 0)))
+            self.work[b, :, :6] = spin @ own @ spin.T
+            weight = np.array([0.0, -bundle.mass[b] * self.g, 0.0])
+            lift = np.array([0.0, bundle.lift[b], 0.0])
+            force = weight + lift - bundle.spring[:, b] * (pose[:3, b] - bundle.rest[:, b])
+            if flowing:
+                u = np.array(flow_at(float(pose[1, b]), t, p.flow[0], p.flow[1]))
+                force += r @ (bundle.drag[:, b] * float(np.linalg.norm(u)) * (r.T @ u))
+            self.work[b, :3, 6] = force
+            self.work[b, 3:, 6] = _cross(r @ bundle.cog[:, b], weight) + _cross(r @ bundle.cob[:, b], lift)
 
     def evaluate(self, pose: np.ndarray, force: np.ndarray) -> None:
         """The bodies' balance at ``pose`` (7, B) with ``force`` (N D) the net force on every node [N] (the
@@ -144,7 +183,10 @@ class StaticBodies:
         of it, ``drag`` (B, 6) its non-conservative part, ``matrix`` (B, 6, 6) their mass matrices, ``stiffness``
         (B, 3, 3) their rotational geometric stiffness."""
         bundle, n = self.bundle, self.model.nodes
-        self.own(self.model.params, pose, self.still, self.t, self.work)
+        if self.compiled:
+            self.own(self.model.params, pose, self.still, self.t, self.work)
+        else:
+            self.own_numpy(pose)
         on_node = np.zeros((n, 3))
         on_node[:, :self.dim] = force.reshape(n, self.dim)
         turned = _matrices(pose[3:7])

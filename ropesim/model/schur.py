@@ -365,10 +365,12 @@ def schur_solve(band, w, lines, groups, rhs):
             rhs[c * dim + b] = val
 
 
-def model_groups(model, w: int, bodies: bool = True) -> Groups:
+def model_groups(model, w: int, bodies: bool = True, arms: bool = True) -> Groups:
     """The groups of ``model``'s Newton matrix (block half-width ``w``): its free points where lines meet
     (:class:`~ropesim.model.junctions.Junctions`), then (with ``bodies``) its free rigid bodies, their arms at their
-    initial poses (:mod:`ropesim.model.body_groups`); the empty bundle for a rope."""
+    initial poses (:mod:`ropesim.model.body_groups`; with ``arms`` False left zero for the caller to place: the
+    static solver of an explicit method, which compiles no :func:`set_body_arms`); the empty bundle for a
+    rope."""
     from .body_groups import body_unknowns, set_body_arms
 
     junctions, free = model.params.junctions, model.params.bodies if bodies else None
@@ -383,6 +385,6 @@ def model_groups(model, w: int, bodies: bool = True) -> Groups:
     if not members:
         return no_groups(model.dim)
     groups = groups_of(model.lines, members, model.dim, w, model.nodes)
-    if free is not None:
+    if free is not None and arms:
         set_body_arms(groups.arm, first, free, model.body_pose0)
     return groups

@@ -27,7 +27,8 @@ taken when it halves the residual. The banded solves make each iteration O(N).
 
 A system of lines is solved the same way: a free point's line ends share one unknown and its balance is the sum
 of the forces on them (:func:`~ropesim.model.junctions.fold_junctions`), the step solved with each line banded
-and the points' unknowns by a Schur complement (:mod:`ropesim.model.schur`). The pseudo-time step starts at the
+and the points' unknowns by a Schur complement (:mod:`ropesim.model.schur`; for an explicit method, whose loop
+compiles none, in NumPy around the banded factor and solve, :mod:`ropesim.model.static_schur`). The pseudo-time step starts at the
 stiffest line's spring period, and no node moves more than the shortest segment in one step.
 
 A free rigid body's unknowns are its reference point's displacement and a small rotation vector (six in 3-D,
@@ -65,6 +66,7 @@ from .junctions import WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_ju
 from .body_groups import StaticBodies
 from .schur import model_groups, schur_factor, schur_solve
 from .static_matrix import DifferencedMatrix
+from .static_schur import NumpySchur
 from .forces.bending import WITH_EI_BENDING
 from .forces.sea import WITH_SEA
 from .terms import (WITH_APPLIED, accelerations, coupling_reach, mechanical_energy, newton_matrix,
@@ -144,7 +146,6 @@ def _solve(model, x: np.ndarray | None, tol: float, max_iterations: int, pose: n
     nt, m = dim * n, w * dim
     jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
     wood = woodbury(nt, m)
-    groups = model_groups(model, w)
     nodes = (free, mass, np.where(model.held, 0.0, model.drag))
     dragged = {WITH_FLUID_DRAG.name, WITH_VISCOUS_DRAG.name} & model.switches
     if not differenced or (cyclic and n < 2 * w + 1):
@@ -153,18 +154,27 @@ def _solve(model, x: np.ndarray | None, tol: float, max_iterations: int, pose: n
     else:   # an explicit method's loop compiles no Newton matrix: differenced from the loop's own force
         differenced = DifferencedMatrix(model, acceleration, w, cyclic, free, mass, nodes[2], t,
                                         model.velocity_dependent)
-    bodies = StaticBodies(model, groups, t) if p.bodies is not None else None
+    groups = model_groups(model, w, arms=differenced is None)   # else placed by StaticBodies, in NumPy
+    bodies = StaticBodies(model, groups, t, differenced is None) if p.bodies is not None else None
     junctions = p.junctions
     if groups.nodes.size:   # a system's free points and bodies: each line banded, they by a Schur complement
+        # an explicit method's loop links no Schur solver: the groups' part in NumPy around the banded one
+        schur = NumpySchur(groups, dim, factor, solve, jac.corner, wood) if differenced is not None else None
+
         def factored() -> bool:
             if junctions is not None:
                 add_junction_added_mass_jacobian(x, jac.band, junctions, p.neighbours)
             if bodies is not None:
                 bodies.fill(tau)
+            if schur is not None:
+                return schur.factor(jac.band)
             return schur_factor(jac.band, w, p.lines, groups)
 
         def inverse(z: np.ndarray) -> np.ndarray | None:
-            schur_solve(jac.band, w, p.lines, groups, z)
+            if schur is not None:
+                schur.solve(z)
+            else:
+                schur_solve(jac.band, w, p.lines, groups, z)
             return bodies.step() if bodies is not None else None   # the bodies' unknowns
 
         def homogeneous(z: np.ndarray) -> np.ndarray | None:
