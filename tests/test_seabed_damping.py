@@ -9,7 +9,7 @@ import tomli_w
 
 import ropesim
 from ropesim.model.build import build
-from ropesim.model.forces.seabed import add_seabed_friction, add_seabed_jacobian, contact_slope
+from ropesim.model.forces.seabed import add_seabed_friction, add_seabed_jacobian
 
 K, C, WIDTH = 1.0e5, 1.0e4, 0.2
 
@@ -109,65 +109,8 @@ def test_galphas_newton_block_is_the_forces_derivative(both_ways, sink, vn):
     v = np.zeros_like(model.x0)
     v[1, 1] = vn
     add_seabed_jacobian(model.x0, v, band, s, np.ones(3, dtype=np.bool_), model.params.seabed, False)
-    spring = s * s * K * WIDTH * 1.0 * contact_slope(sink, model.params.seabed[0][11])   # the contact spring's
-    # part, k A times galpha's onset slope (tested below)
+    spring = s * s * K * WIDTH * 1.0   # the contact spring's part, k A
     expected = -(s * s * dfdy + s * dfdv)
     if both_ways and vn > 0.0 and sink < 1e-3 * WIDTH:   # lifting off inside the growth depth: the growth's
         expected = -s * dfdv   # stiffness is negative there, and is left out of the matrix (kept positive)
     assert band[0, 1 * dim + 1] - spring == pytest.approx(expected, rel=1e-5, abs=1e-6 * spring)
-
-
-def test_galphas_contact_onset_is_c1_and_exact_past_its_depth():
-    """galpha's contact spring pushes with k A contact_depth(delta): 0 with zero slope at first contact, the plain
-    k A delta from delta_s on (value and slope continuous there), monotone, its slope within 0..4/3; and the
-    contact energy is its integral (the energy's derivative along the normal is the force)."""
-    from ropesim.model.forces.seabed import contact_depth, contact_energy
-
-    ds = 1e-3
-    sinks = np.linspace(0.0, 2 * ds, 4001)
-    push = np.array([contact_depth(d, ds) for d in sinks])
-    slope = np.array([contact_slope(d, ds) for d in sinks])
-    assert push[0] == 0.0 and slope[0] == 0.0
-    assert np.all(np.diff(push) >= 0.0) and slope.max() <= 4.0 / 3.0 + 1e-12
-    past = sinks >= ds
-    assert np.array_equal(push[past], sinks[past]) and np.all(slope[past] == 1.0)
-    assert np.abs(np.diff(slope)).max() < 2e-3   # no kink: 4/3 over 2000 samples moves it by at most ~1e-3
-    assert np.allclose(np.gradient(push, sinks)[1:-1], slope[1:-1], atol=2e-3)
-    energy = np.array([contact_energy(d, ds) for d in sinks])
-    assert np.allclose(np.gradient(energy, sinks)[1:-1], push[1:-1], rtol=1e-6, atol=1e-6 * ds)
-    assert contact_depth(0.3, 0.0) == 0.3 and contact_energy(0.3, 0.0) == 0.5 * 0.3 * 0.3   # other methods
-
-
-def test_galphas_onset_depth_is_a_quarter_of_the_static_sink_and_only_galphas():
-    """delta_s = ONSET_DEPTH w / (k A) on the lightest-loaded node (w its weight in water); 0 (no onset) for every
-    other method; and the energy the model reports is the force's potential."""
-    from ropesim.model.forces.seabed import ONSET_DEPTH, SEABED_TERM, add_seabed_contact, seabed_energy
-
-    def scene(method):
-        return ropesim.scene_from_toml(tomli_w.dumps({
-            "name": "resting", "dimension": 2,
-            "rope": {"length": 2.0, "segments": 2, "mass_per_length": 100.0, "diameter": WIDTH, "EA": 1e6},
-            "initial": {"shape": "points", "points": [[0.0, -1e-4], [1.0, -1e-4], [2.0, -1e-4]]},
-            "integrator": {"method": method, "dt": 1e-3, "t_end": 1e-2},
-            "gravity": {"g": 9.81}, "fluid": {"density": 1000.0}, "buoyancy": {},
-            "seabed": {"height": 0.0, "stiffness": K, "damping": C},
-        }))
-
-    model = build(scene("galpha"))
-    bed, area = model.params.seabed
-    wet = 100.0 - 1000.0 * np.pi * WIDTH ** 2 / 4   # kg per metre, in water
-    assert bed[11] == pytest.approx(ONSET_DEPTH * wet * 9.81 / (K * WIDTH), rel=1e-12)
-    assert build(scene("rk4")).params.seabed[0][11] == 0.0
-    x = model.x0.copy()
-    for sink in (0.3 * bed[11], 3 * bed[11]):
-        x[1] = -sink
-        h = 1e-6 * bed[11]
-        xs = [x.copy(), x.copy()]
-        xs[0][1] += h
-        xs[1][1] -= h
-        de = (SEABED_TERM.energy(model, xs[1].T) - SEABED_TERM.energy(model, xs[0].T)) / (2 * h)
-        acc = np.zeros_like(x)
-        add_seabed_contact(x, acc, 1.0 / model.mass, model.params.seabed)
-        assert de == pytest.approx(float(np.sum(acc[1] * model.mass)), rel=1e-6)
-        kernel = (seabed_energy(xs[1], model.params.seabed) - seabed_energy(xs[0], model.params.seabed)) / (2 * h)
-        assert kernel == pytest.approx(de, rel=1e-6)

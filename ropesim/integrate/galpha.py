@@ -61,7 +61,7 @@ import numpy as np
 from ..model import jit
 from ..model.banded import factor, solve, woodbury
 from ..model.forces.added_mass import added_mass_times
-from ..model.forces.seabed import WITH_SEABED, contact_depth, depth
+from ..model.forces.seabed import WITH_SEABED, depth
 from ..model.jacobian import Jacobian, band_width
 from ..model.bodies import WITH_BODIES, place_attachments
 from ..model.junctions import (WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_junctions,
@@ -368,7 +368,7 @@ def friction_slope(x, v, band, weight, free, seabed):
         s0, s1, s2 = v[0, i] - vn * nx, v[1, i] - vn * ny, v[2, i] if dim == 3 else 0.0
         slide2 = s0 * s0 + s1 * s1 + s2 * s2
         big = math.sqrt(slide2 + bed[8] * bed[8])
-        c = weight * mu * bed[4] * contact_depth(sunk, bed[11]) * area[i] / (big * big * big)
+        c = weight * mu * bed[4] * sunk * area[i] / (big * big * big)
         s = (s0, s1, s2)
         for a in range(dim):
             for b in range(a + 1):

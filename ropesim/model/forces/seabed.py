@@ -5,10 +5,7 @@ of it. A node at distance s = n . (x - (0, height[, 0])) from it is in contact w
 delta = -s. On its footprint A = contact_width x L (L its share of unstretched length; MoorDyn's d l) it feels
 
 - the contact spring k delta A along n (``stiffness`` k per unit area, MoorDyn's kBot): conservative, energy
-  k delta^2 A / 2, a position-only term. With the ``galpha`` integrator its onset is C1: k A delta_s (2 u^2 - u^3),
-  u = delta / delta_s, for delta < delta_s (:func:`contact_depth`; exact from delta_s on, energy its integral),
-  delta_s = 0.25 w / (k A) of the lightest-loaded node (its static sink under its weight in water w; WD0050:
-  3.3 cm against resting sinks of 7-13 cm, so the static shape is unchanged);
+  k delta^2 A / 2, a position-only term;
 - the contact damping c |v . n| A f(delta) along n while the node moves into the plane (``damping`` c,
   MoorDyn's cBot), none while it moves out: the seabed resists being pressed but never holds a node back
   (MoorDyn damps both ways, which makes its seabed sticky: a node lifting off at 0.1 m/s is held by c A v, for
@@ -37,7 +34,7 @@ The damping and friction depend on velocity; their work is the energy ledger's `
 
 Parameters: ``seabed`` = (scalars [height, tan a, cos a, sin a, k, c, mu, mu_axial, v_reg, delta_d,
 both ways (1), both ways grown in over delta_d (2, galpha's), into the plane only (0) or so with its switch
-smoothed over v_reg (-1, galpha's), delta_s (galpha's contact onset; 0: none)], footprint (N,) [m^2]).
+smoothed over v_reg (-1, galpha's)], footprint (N,) [m^2]).
 """
 
 from __future__ import annotations
@@ -48,14 +45,12 @@ import numpy as np
 
 from . import Term
 from ..layout import per_node
-from .buoyancy import displaced_volume
 from .fluid import node_tangent
 from .. import jit
 
 WITH_SEABED = jit.Switch("seabed", "the seabed's contact and friction")
-SEABED_PARAMS = 12
+SEABED_PARAMS = 11
 DAMPING_DEPTH = 1e-3   # delta_d / the footprint's width: the depth over which the contact damping grows
-ONSET_DEPTH = 0.25   # delta_s / the static sink of the lightest-loaded node: galpha's contact onset
 
 
 @jit.kernel(inline="always")
@@ -74,37 +69,6 @@ def inward(vn, scale):
         return vn
     u = -vn / scale
     return -scale * u * u * (2.0 - u)
-
-
-@jit.kernel(inline="always")
-def contact_depth(sunk, scale):
-    """The depth the contact spring pushes with [m]: delta itself, except with galpha (``scale`` = delta_s > 0)
-    for 0 < delta < delta_s, where it is delta_s (2 u^2 - u^3), u = delta / delta_s (C1 at first contact,
-    exact from delta_s on; :func:`inward`'s polynomial)."""
-    if sunk >= scale:
-        return sunk
-    u = sunk / scale
-    return scale * u * u * (2.0 - u)
-
-
-@jit.kernel(inline="always")
-def contact_slope(sunk, scale):
-    """d contact_depth / d delta (0 at first contact, at most 4/3, 1 from delta_s on)."""
-    if sunk >= scale:
-        return 1.0
-    u = sunk / scale
-    return u * (4.0 - 3.0 * u)
-
-
-@jit.kernel(inline="always")
-def contact_energy(sunk, scale):
-    """The integral of contact_depth over 0..delta [m^2]: delta^2 / 2, less delta_s^2 / 12 from delta_s on."""
-    if scale <= 0.0:
-        return 0.5 * sunk * sunk
-    if sunk >= scale:
-        return 0.5 * sunk * sunk - scale * scale / 12.0
-    u = sunk / scale
-    return scale * scale * u * u * u * (2.0 / 3.0 - 0.25 * u)
 
 
 @jit.kernel(inline="always")
@@ -127,7 +91,7 @@ def add_seabed_contact(x, acc, inv_mass, seabed):
     for i in range(n):
         sunk = depth(x[0, i], x[1, i], bed)
         if sunk > 0.0:
-            f = bed[4] * contact_depth(sunk, bed[11]) * area[i] * inv_mass[i]
+            f = bed[4] * sunk * area[i] * inv_mass[i]
             acc[0, i] += f * nx
             acc[1, i] += f * ny
 
@@ -167,8 +131,7 @@ def add_seabed_friction(x, v, acc, inv_mass, seabed, around):
             if tl > 0.0:
                 tx, ty, tz = tx / tl, ty / tl, tz / tl
                 along = sx * tx + sy * ty + sz * tz
-            scale = (k * contact_depth(sunk, bed[11]) * area[i]
-                     / math.sqrt(sx * sx + sy * sy + sz * sz + v_reg * v_reg))
+            scale = k * sunk * area[i] / math.sqrt(sx * sx + sy * sy + sz * sz + v_reg * v_reg)
             ax, ay, az = along * tx, along * ty, along * tz
             fx -= scale * (mu_axial * ax + mu * (sx - ax))
             fy -= scale * (mu_axial * ay + mu * (sy - ay))
@@ -190,10 +153,7 @@ def seabed_energy(x, seabed):
     for i in range(x.shape[1]):
         sunk = depth(x[0, i], x[1, i], bed)
         if sunk > 0.0:
-            if bed[11] > 0.0:
-                e += bed[4] * contact_energy(sunk, bed[11]) * area[i]
-            else:
-                e += 0.5 * bed[4] * sunk * sunk * area[i]
+            e += 0.5 * bed[4] * sunk * sunk * area[i]
     return e
 
 
@@ -216,8 +176,6 @@ def add_seabed_jacobian(x, v, band, beta, free, seabed, friction):
             continue
         vn = v[0, i] * normal[0] + v[1, i] * normal[1]
         along_n = beta * beta * bed[4] * area[i]
-        if sunk < bed[11]:   # galpha's contact onset
-            along_n *= contact_slope(sunk, bed[11])
         if bed[10] > 1.0:
             along_n += beta * bed[5] * area[i] * min(1.0, sunk / bed[9])
             if sunk < bed[9] and vn < 0.0:   # its growth's stiffness, where positive
@@ -236,8 +194,7 @@ def add_seabed_jacobian(x, v, band, beta, free, seabed, friction):
         if friction and mu > 0.0:
             vz = v[2, i] if dim == 3 else 0.0
             sx, sy = v[0, i] - vn * normal[0], v[1, i] - vn * normal[1]
-            slide = (beta * mu * bed[4] * contact_depth(sunk, bed[11]) * area[i]
-                     / math.sqrt(sx * sx + sy * sy + vz * vz + bed[8] * bed[8]))
+            slide = beta * mu * bed[4] * sunk * area[i] / math.sqrt(sx * sx + sy * sy + vz * vz + bed[8] * bed[8])
         for a in range(dim):
             for b in range(a + 1):
                 nn = normal[a] * normal[b]
@@ -252,48 +209,18 @@ def _params(scene, layout) -> tuple:
              else per_node(layout.lines, n, [line.diameter or 0.0 for line in layout.lines]))
     scalars = np.array([bed.height, math.tan(a), math.cos(a), math.sin(a), bed.stiffness, bed.damping, bed.friction,
                         bed.friction if bed.friction_axial is None else bed.friction_axial, bed.friction_speed,
-                        DAMPING_DEPTH * float(width.max(initial=0.0)), 1.0 if bed.damping_both_ways else 0.0, 0.0])
-    area = width * layout.node_length
+                        DAMPING_DEPTH * float(width.max(initial=0.0)), 1.0 if bed.damping_both_ways else 0.0])
     if scene.integrator.method == "galpha":   # forces without a jump or a kink in v . n for its Newton solve:
         scalars[10] = 2.0 if bed.damping_both_ways else -1.0   # MoorDyn's law grown in over delta_d; the one-way
         # law's switch at rest smoothed over v_reg
-        scalars[11] = onset_depth(scene, layout, area, scalars[9])
-    return scalars, area
-
-
-def static_sink(scene, layout, area: np.ndarray) -> np.ndarray:
-    """How deep each node would rest on a level seabed under its own weight in water, w_i / (k A_i) [m] (0 where
-    it has no footprint or floats; the line's tension left out)."""
-    bed = scene.seabed
-    if scene.gravity is None or bed.stiffness <= 0.0:
-        return np.zeros(len(layout.mass))
-    weight = layout.mass * scene.gravity.g
-    if scene.buoyancy is not None and scene.fluid is not None:
-        weight = weight - scene.fluid.density * displaced_volume(scene, layout) * scene.gravity.g
-    with np.errstate(divide="ignore", invalid="ignore"):
-        sink = np.where(area > 0.0, weight / (bed.stiffness * area), 0.0)
-    return np.maximum(sink, 0.0)
-
-
-def onset_depth(scene, layout, area: np.ndarray, damping_depth: float) -> float:
-    """galpha's delta_s: ONSET_DEPTH times the static sink of the lightest-loaded grounded node, over which the
-    contact spring is grown in C1 (:func:`contact_depth`); delta_d when no node has a weight to rest with."""
-    sink = static_sink(scene, layout, area)
-    sink = sink[sink > 0.0]
-    return ONSET_DEPTH * float(sink.min()) if sink.size else damping_depth
+    return scalars, width * layout.node_length
 
 
 def _energy(model, x: np.ndarray) -> np.ndarray:
-    """k delta^2 A / 2 summed over the nodes [J], for frames x (..., N, D) (galpha's: k A times the integral of
-    :func:`contact_depth`)."""
+    """k delta^2 A / 2 summed over the nodes [J], for frames x (..., N, D)."""
     bed, area = model.params.seabed
     x = np.asarray(x)
     sunk = np.maximum((bed[0] + bed[1] * x[..., 0] - x[..., 1]) * bed[2], 0.0)
-    if bed[11] > 0.0:
-        u = np.minimum(sunk / bed[11], 1.0)
-        soft = np.where(sunk < bed[11], bed[11] ** 2 * u ** 3 * (2.0 / 3.0 - 0.25 * u),
-                        0.5 * sunk * sunk - bed[11] ** 2 / 12.0)
-        return bed[4] * np.einsum("...n,n->...", soft, area)
     return 0.5 * bed[4] * np.einsum("...n,n->...", sunk * sunk, area)
 
 
