@@ -17,7 +17,8 @@ interleaved case by case with this checkout so both see the same machine load; t
 their ratio. CPU time is kept beside wall time because the machine is shared: a loaded machine stretches wall
 time far more than CPU time.
 
-    python scripts/bench_first_run.py [--against REV] [--rounds 1] [--scenes a,b] [--warm-only] [--json FILE]
+    python scripts/bench_first_run.py [--against REV] [--rounds 1] [--scenes a,b@galpha]
+        [--warm-only] [--json FILE]
 """
 
 from __future__ import annotations
@@ -98,10 +99,13 @@ def cold_and_warm(tree: Path, args: list[str], work: Path) -> dict:
 
 
 def first_step(scene: str, out: Path) -> list[str]:
+    """One step of ``scene``, or of ``NAME@METHOD``: scene NAME with ``--set integrator.method=METHOD``."""
     from ropesim import load_scene
 
+    scene, _, method = scene.partition("@")
     dt = load_scene(scene).integrator.dt
-    return ["run", scene, "--set", f"integrator.t_end={dt!r}", "--out", str(out), "--quiet", "--force"]
+    chosen = ["--set", f"integrator.method={method}"] if method else []
+    return ["run", scene, *chosen, "--set", f"integrator.t_end={dt!r}", "--out", str(out), "--quiet", "--force"]
 
 
 def accuracy(out: Path) -> list[str]:
@@ -132,7 +136,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--against", metavar="REV", help="also measure this git revision, interleaved")
     parser.add_argument("--rounds", type=int, default=1, help="cold measurements per case (the median is shown)")
-    parser.add_argument("--scenes", help="comma-separated built-in scenes (default: all)")
+    parser.add_argument("--scenes", help="comma-separated built-in scenes, NAME@METHOD for another method "
+                                         "(default: all)")
     parser.add_argument("--warm-rounds", type=int, default=15, help="paired rounds of the warm whole process")
     parser.add_argument("--warm-only", action="store_true", help="only the warm whole process (no cold cases)")
     parser.add_argument("--json", metavar="FILE", help="also write every measurement to FILE")

@@ -123,7 +123,7 @@ def place_stage(body, X, V, beta, bodies, arm):
     set_body_arms(arm, body.where[0], bodies, body.pose)
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def _add_centripetal(own, m00, m01, m02, m11, m12, m22, p0, p1, p2, w0, w1, w2, scale):
     """Add scale times -d/dw of a mass M's centripetal force -M w x (w x p) at arm p, and of its moment, to
     ``own``'s rotation columns: f = -M ([w x p]x + [w]x [p]x) into the force rows, p x f into the moment rows
@@ -150,7 +150,7 @@ def _add_centripetal(own, m00, m01, m02, m11, m12, m22, p0, p1, p2, w0, w1, w2, 
         own[5, 3 + j] += scale * t2
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def _add_turning_force(own, f0, f1, f2, p0, p1, p2, scale):
     """Add scale times K_phi = (F . p) I - p F^T of a force F at arm p that turns with the body (rotation block)."""
     fp = f0 * p0 + f1 * p1 + f2 * p2
@@ -161,7 +161,7 @@ def _add_turning_force(own, f0, f1, f2, p0, p1, p2, scale):
             own[3 + i, 3 + j] += scale * ((fp if i == j else 0.0) - p[i] * f[j])
 
 
-@jit.kernel(inline="always")
+@jit.kernel(literal_integers=False)
 def _add_drag_rate(own, row, r, d0, d1, d2, u0, u1, u2, scale):
     """Add scale times R diag(d) (|u| I + u u^T / |u|) R^T (u in body axes) to the 3 x 3 block at (row, row)."""
     speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)

@@ -371,7 +371,7 @@ def _times_inverse(inverse, n, work):
         work[i, 0] = s
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def own_load(gravity, flow, bodies, pose, twist, b, t, r):
     """Body b's own force [N] and moment [N m] about its reference point, in its axes (R^T of the world's): its
     weight and centripetal force at its centre of gravity, the gyroscopic moment -w x (I w), its buoyancy at its
@@ -439,7 +439,7 @@ def own_load(gravity, flow, bodies, pose, twist, b, t, r):
     return f0, f1, f2, m0, m1, m2, power
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def body_own_system(work, gravity, flow, bodies, pose, twist, b, t, power):
     """Body b's own part of its Newton-Euler equations (see the module doc) into ``work`` (6, 7), zeroed first, in
     world axes: its mass at its centre of gravity, inertia and added mass (the matrix), its own force and moment
@@ -467,7 +467,7 @@ def body_own_system(work, gravity, flow, bodies, pose, twist, b, t, power):
     return power + own
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def body_attachments_system(work, x, acc, inv_mass, around, bodies, pose, twist, b):
     """Add body b's attachments to its Newton-Euler equations in ``work`` (6, 7), world axes: each node's mass and
     added mass at its arm, and its force m_i acc_i less its centripetal part (``acc`` holding each node's
