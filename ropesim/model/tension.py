@@ -18,13 +18,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import jit
 from .bodies import body_frames, body_shapes
 from .forces.fluid import flow_at
 from .forces.springs import segment_forces, segment_strains
 from .motion import Held, place_moving
 from .sea_frames import sea_frames, sea_shapes
-from .terms import WITH_MOTION, accelerations
+from .terms import accelerations
 
 
 def segment_count(model) -> int:
@@ -76,48 +75,22 @@ def held_forces(model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> tuple[np.
     its inertia: MoorDyn's report), per frame (F, H, D) [N]."""
     idx, m = model.held_idx, model.motion
     mass = model.mass[idx][:, None]
-    x = np.ascontiguousarray(x, dtype=float)
-    v = np.ascontiguousarray(v, dtype=float)
-    t = np.ascontiguousarray(t, dtype=float).reshape(-1)
-    pulled = np.zeros((len(t), idx.size, model.dim))
-    prescribed = np.zeros_like(pulled)
-    # the prescribed accelerations a_p (with a motion), as the loops compute them, into a Held of its own
-    held = Held(idx, model.held_x0, model.held_v.copy(), m._replace(accel=np.zeros_like(m.accel)))
-    model.kernel(held_accelerations)(x, v, t, np.zeros((model.dim, model.nodes)), np.zeros((model.dim, model.nodes)),
-                                     np.zeros((model.dim, model.nodes)), pulled, prescribed, held, model.params)
-    if model.scene.flow is None:
-        drag = -model.drag[idx][None, :, None] * v[:, idx, :]
-    else:
-        drag = np.stack([held_linear_drag(model, float(t[k]), x[k].T, v[k].T) for k in range(len(t))])
-    net = mass * pulled + drag.reshape(pulled.shape)
-    out = -net
-    if m.moving:
-        out += mass * prescribed
+    acc = np.zeros((model.dim, model.nodes))
+    out = np.zeros((len(t), idx.size, model.dim))
+    net = np.zeros_like(out)
+    forces = model.kernel(accelerations)
+    if m.moving:   # the prescribed accelerations a_p, as the loops compute them
+        held = Held(idx, model.held_x0, model.held_v.copy(), m._replace(accel=np.zeros_like(m.accel)))
+        prescribed = model.kernel(place_moving)
+    for k in range(len(t)):
+        xk, vk = np.ascontiguousarray(np.asarray(x[k]).T), np.ascontiguousarray(np.asarray(v[k]).T)
+        forces(xk, vk, acc, model.params, float(t[k]))
+        net[k] = mass * acc[:, idx].T + held_linear_drag(model, float(t[k]), xk, vk)
+        out[k] = -net[k]
+        if m.moving:
+            prescribed(xk.copy(), vk.copy(), held, float(t[k]), float(t[k]))
+            out[k] += mass * held[3].accel.T
     return out, net
-
-
-@jit.kernel
-def held_accelerations(x, v, t, xs, vs, acc, pulled, prescribed, held, params):
-    """Per frame k of x, v (F, N, D) at times t (F,): every term's force / m on each held node into ``pulled``
-    (F, H, D), and with a prescribed motion its acceleration a_p into ``prescribed`` (F, H, D); xs, vs, acc
-    (D, N) scratch. One call for all the frames of a chunk: a call per frame handed the parameter bundle over
-    each time, which cost as much as a step of galpha at 0.1 s."""
-    frames, n, dim = x.shape
-    idx = held.idx
-    for k in range(frames):
-        for i in range(n):
-            for d in range(dim):
-                xs[d, i] = x[k, i, d]
-                vs[d, i] = v[k, i, d]
-        accelerations(xs, vs, acc, params, t[k])
-        for j in range(idx.shape[0]):
-            for d in range(dim):
-                pulled[k, j, d] = acc[d, idx[j]]
-        if WITH_MOTION:
-            place_moving(xs, vs, held, t[k], t[k])
-            for j in range(idx.shape[0]):
-                for d in range(dim):
-                    prescribed[k, j, d] = held.motion.accel[d, j]
 
 
 def held_linear_drag(model, t: float, x: np.ndarray, v: np.ndarray) -> np.ndarray:
