@@ -384,6 +384,17 @@ def test_ctrl_c_while_the_command_line_starts_is_one_line(tmp_path):
         assert "Traceback" not in err and err.strip(), (delay, out, err)
 
 
+def test_ctrl_c_stays_one_line_until_main_takes_it_over():
+    """The command line's modules loaded, main() still had imports and signal set-up to do before its own try:
+    Ctrl-C handed back to Python at the end of ``import ropesim.cli`` landed there as a traceback (seen: a
+    KeyboardInterrupt in main's import of .status). Importing the CLI keeps the one-line handler; main() gives
+    Ctrl-C back to Python inside the try that reports it."""
+    probe = ("import signal, sys; sys.argv[0] = 'ropesim'; import ropesim.cli; "
+             "print(signal.getsignal(signal.SIGINT).__name__)")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120)
+    assert done.stdout.strip() == "_interrupted_while_loading", done.stderr
+
+
 # ----------------------------------------------------------------------------------- the compile cache
 
 

@@ -97,7 +97,7 @@ EXIT_BAD_INPUT, EXIT_BLEW_UP, EXIT_WRITE, EXIT_INTERRUPTED = 2, 3, 4, 130
 SIGNAL_EXIT = {"SIGINT": 130, "SIGTERM": 143, "SIGHUP": 129}   # 128 + the signal's number, as a shell reports
 
 
-from ..stop import Stopped  # noqa: E402
+from ..stop import Stopped, quiet_interrupts_while_loading, started_as_the_command_line  # noqa: E402
 
 
 def exit_code(exc: BaseException | None = None, name: str = "") -> int:
@@ -1220,13 +1220,15 @@ def main() -> None:
     keeps its frames); outside a run's own clean stop (say, while Python imports) they are one line too."""
     import signal
 
+    from .status import close_early, start_early
+
     for name in ("SIGTERM", "SIGHUP"):
         if hasattr(signal, name):
             signal.signal(getattr(signal, name), _raise_stopped)
-    from .status import close_early, start_early
-
-    start_early(sys.argv[1:])   # `ropesim run` on a terminal: its spinner, before Typer parses (0.15 s)
     try:
+        if started_as_the_command_line():   # Ctrl-C while modules loaded ended at once (ropesim.stop); from
+            quiet_interrupts_while_loading(False)   # here on it is a KeyboardInterrupt, handled below
+        start_early(sys.argv[1:])   # `ropesim run` on a terminal: its spinner, before Typer parses (0.15 s)
         app()
     except (KeyboardInterrupt, Stopped) as exc:
         close_early()
