@@ -93,16 +93,17 @@ def warm_up(scene) -> None:
 
 def warm_up_static_solver(scene) -> None:
     """Compile (or load) the static solver of ``initial.shape = 'equilibrium'`` and `ropesim equilibrium` for
-    ``scene``'s parts: one Newton iteration of it on ``scene``'s model, from a guess off equilibrium, and the
-    support forces it reports."""
+    ``scene``'s parts: one Newton iteration of it on ``scene``'s model, from a guess off equilibrium, with each
+    matrix it may take (an explicit method's differenced one and its analytic fallback), and the support forces
+    it reports."""
     import numpy as np
 
     from .analysis.statics import static_loads
     from .model.build import build
-    from .model.statics import solve_equilibrium
+    from .model.statics import warm_up
 
     model = build(scene, solve=False)
-    result = solve_equilibrium(model, model.x0 * 1.001 + 0.01, max_iterations=1)
+    result = warm_up(model, model.x0 * 1.001 + 0.01)
     static_loads(model, np.ascontiguousarray(result.x))
 
 

@@ -38,7 +38,7 @@ and its residual after each of the last ones agrees to two digits (``scripts/sta
 with EI bending is the exception: its softest mode (3 EI / L^3, 4.3 kN/m for cantilever_beam) is 3e-6 of a
 segment's axial stiffness (1.5 GN/m), below the differences' round-off, and the differenced iteration stalled
 at 6e-9 of the force scale. Such a scene takes the analytic matrix, as does any solve whose differenced
-iteration stalls (:func:`ropesim.model.statics.solve_equilibrium`). Where the drag's
+iteration stalls or does not converge (:func:`ropesim.model.statics.solve_equilibrium`). Where the drag's
 tangent stiffness is large (a rope in a side wind), its symmetric part in the banded matrix can make it
 indefinite at a large pseudo-time step, which the solver then shortens: helicopter_crosswind solved with rk4
 takes 38 iterations against the analytic matrix's 20 (6 factorisations refused), to the same shape.

@@ -118,15 +118,29 @@ def solve_equilibrium(model, x: np.ndarray | None = None, tol: float = TOL,
     The Newton matrix is differenced from the scene's compiled force (:mod:`ropesim.model.static_matrix`) unless
     the scene's method compiles the analytic one anyway (:data:`ANALYTIC_MATRIX_METHODS`) or declares EI
     bending (a beam's soft modes are below the differences' round-off). Should the differenced iteration stall
-    (its pseudo-time step shrunk to nothing), the solve starts again from the same guess with the analytic
-    matrix. One that merely runs out of iterations does not: no built-in scene converges on either matrix that
-    fails on the other (the string shooters, driven by their wheels, have no equilibrium: 2000 iterations on
-    both), and a second run would only double the time and compile the analytic matrix."""
-    differenced = not (model.scene.integrator.method in ANALYTIC_MATRIX_METHODS
-                       or WITH_EI_BENDING.name in model.switches)
+    (its pseudo-time step shrunk to nothing) or not converge in the full ``MAX_ITERATIONS``, the solve starts
+    again from the same guess with the analytic matrix: no scene converges with it that did before (a free body
+    imported from MoorDyn and a floating box under a sea need it). :func:`warm_up` prepares both."""
+    differenced = _differences(model)
     result, stalled = _solve(model, x, tol, max_iterations, pose, differenced)
-    if differenced and not result.converged and stalled:
+    if differenced and not result.converged and (stalled or max_iterations >= MAX_ITERATIONS):
         result, _ = _solve(model, x, tol, max_iterations, pose, False)
+    return result
+
+
+def _differences(model) -> bool:
+    """Whether the static solve differences its Newton matrix (see :func:`solve_equilibrium`)."""
+    return not (model.scene.integrator.method in ANALYTIC_MATRIX_METHODS or WITH_EI_BENDING.name in model.switches)
+
+
+def warm_up(model, x: np.ndarray) -> Equilibrium:
+    """One iteration from ``x`` with each Newton matrix :func:`solve_equilibrium` may take for ``model`` (the
+    differenced one and its analytic fallback), so that `ropesim compile` prepares whatever a solve compiles;
+    returns the first one's result."""
+    differenced = _differences(model)
+    result, _ = _solve(model, x, TOL, 1, None, differenced)
+    if differenced:
+        _solve(model, x, TOL, 1, None, False)
     return result
 
 
