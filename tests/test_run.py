@@ -82,6 +82,32 @@ def test_blow_up_stops_cleanly_and_keeps_frames(scenarios, tmp_path):
     assert rerun.summary["status"] == "completed"
 
 
+
+@pytest.mark.parametrize("method, code", [("galpha", "NEWTON_FAILED"), ("sdirk2", "NEWTON_FAILED"),
+                                          ("verlet", "NEWTON_FAILED"), ("verlet", "NON_FINITE")])
+def test_blow_up_advice_claims_stability_only_from_the_bound(scenarios, method, code):
+    """Only an explicit method stepping above its stability bound is told a step "would be stable" (half the
+    bound); a Newton failure, or a blow-up below the bound, is told to try a quarter of its step, which no bound
+    backs. Nothing compiles: the message is built from the model and the stopped integrator's clock."""
+    from types import SimpleNamespace
+
+    from ropesim import run
+    from ropesim.analysis.stability import predicted_dt
+
+    scene = ropesim.load_scene(scenarios / "helicopter_uniform.toml", [f"integrator.method={method}"])
+    model = build(scene)
+    bound = predicted_dt(model, method)
+    dt = 2.0 * bound if np.isfinite(bound) else 0.05
+    stopped = SimpleNamespace(grid=SimpleNamespace(dt=dt), t=1.5, step=30, limits=(4.0,))
+    stable_dt, message = run._blow_up_message(model, stopped, getattr(run, code), 7)
+    assert message.startswith("blew up at t = 1.5 s (step 30): ") and "node 7" in message
+    if method == "verlet" and code == "NON_FINITE":
+        assert stable_dt == pytest.approx(0.5 * bound) and message.endswith("or less would be stable")
+    else:
+        assert stable_dt == pytest.approx(0.25 * dt) and "would be stable" not in message
+        assert f"try a time step of {stable_dt:.3g} s (a quarter of this one)" in message
+        assert ("integrator.tolerance" in message) == (method == "galpha")
+
 def test_interrupt_keeps_what_was_computed(scenarios, tmp_path):
     scene = ropesim.load_scene(scenarios / "helicopter_uniform.toml", ["integrator.t_end=5000"])
     model = build(scene)
