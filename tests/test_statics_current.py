@@ -19,7 +19,8 @@ import ropesim
 from ropesim.analysis.statics import equilibrium
 from ropesim.model.build import build
 from ropesim.model.forces.fluid import add_fluid_tangent_stiffness
-from ropesim.model.statics import _steady_time, nonconservative_forces
+from ropesim.model.statics import _nonconservative, _steady_time, forces_on_free_nodes, nonconservative_forces
+from ropesim.model.terms import accelerations
 
 
 def hanging_line(current: float, cd_normal: float = 1.2, cd_tangential: float = 0.01, dimension: int = 2,
@@ -111,3 +112,26 @@ def test_the_tangent_stiffness_is_the_drags_derivative(dimension, closed):
                 expected = blocks[i, offset, :, b] if 0 <= offset <= 2 else np.zeros(dim)
                 # the flow's shear is left out: a uniform flow here, so the drag depends on x only via q
                 assert np.allclose(numeric[i], expected, rtol=1e-5, atol=1e-6 * np.abs(blocks).max()), (i, j, b)
+
+
+@pytest.mark.parametrize("dimension,viscous", [(2, False), (3, False), (3, True)])
+def test_the_merits_force_in_a_flow_is_the_drag_at_rest(dimension, viscous):
+    """The static merit's non-conservative force at rest, taken as the net force in the flow less the net force
+    in still water (both by the loop's compiled term list, so that a static start compiles nothing more), is the
+    flow's drag on the nodes at rest that the compiled nonconservative_forces gives, to the round-off of the net
+    force; at a bent, stretched shape, where springs pull far harder than the current drags."""
+    scene = hanging_line(1.3, cd_tangential=0.3, dimension=dimension, viscous=viscous)
+    model = build(scene, solve=False)
+    rng = np.random.default_rng(11)
+    x = model.x0 + rng.normal(scale=2.0, size=model.x0.shape)
+    n, dim = model.nodes, model.dim
+    v, acc = np.zeros_like(x), np.zeros_like(x)
+    free = np.ascontiguousarray(~model.held)
+    t = _steady_time(scene)
+    forces = _nonconservative(model, model.kernel(accelerations), v, acc, t, free, model.params.junctions)
+    out, drag, net = np.zeros(n * dim), np.zeros(n * dim), np.zeros(n * dim)
+    forces(x, out)
+    model.kernel(nonconservative_forces)(x, v, np.zeros_like(x), model.params, t, model.mass, free, drag)
+    scale = forces_on_free_nodes(model.kernel(accelerations), x, v, acc, model.params, t, model.mass, free, net)
+    assert np.abs(drag).max() > 10.0                     # N: the current's drag on a node's 2.5 m
+    assert np.abs(out - drag).max() <= 1e-13 * scale     # equal to the net force's round-off (here 3e-7 N)

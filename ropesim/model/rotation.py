@@ -97,19 +97,19 @@ def matrix_of(q, b):
             2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y))
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def rotate(r, v0, v1, v2):
     """R v, ``r`` R's nine entries row by row (:func:`matrix_of`)."""
     return (r[0] * v0 + r[1] * v1 + r[2] * v2, r[3] * v0 + r[4] * v1 + r[5] * v2, r[6] * v0 + r[7] * v1 + r[8] * v2)
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def rotate_back(r, v0, v1, v2):
     """R^T v: a world vector in the body's axes."""
     return (r[0] * v0 + r[3] * v1 + r[6] * v2, r[1] * v0 + r[4] * v1 + r[7] * v2, r[2] * v0 + r[5] * v1 + r[8] * v2)
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def cross(a0, a1, a2, b0, b1, b2):
     """a x b."""
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
@@ -142,7 +142,7 @@ def unit_scale(n2):
     return 1.0 / math.sqrt(n2)
 
 
-@jit.kernel(inline="always")
+@jit.kernel
 def turn(q, b, p0, p1, p2):
     """q[:, b] <- exp(p) q[:, b], normalised: the orientation turned by the world-frame rotation vector p [rad]."""
     c, s = half_turn(p0 * p0 + p1 * p1 + p2 * p2)

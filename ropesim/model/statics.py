@@ -61,7 +61,7 @@ from .banded import factor as factor_newton_matrix
 from .banded import solve as solve_newton_matrix
 from .banded import woodbury
 from .jacobian import Jacobian, band_width
-from .forces.fluid import WITH_FLOW, WITH_FLUID_DRAG, WITH_VISCOUS_DRAG, add_fluid_tangent_stiffness
+from .forces.fluid import WITH_FLOW, WITH_FLUID_DRAG, WITH_VISCOUS_DRAG, add_fluid_tangent_stiffness, still_flow
 from .junctions import WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_junctions
 from .body_groups import StaticBodies
 from .schur import model_groups, schur_factor, schur_solve
@@ -151,8 +151,8 @@ def _solve(model, x: np.ndarray | None, tol: float, max_iterations: int, pose: n
     pose = np.array(model.body_pose0 if pose is None else pose, dtype=float)
     dim, n = x.shape
     scene, p = model.scene, model.params
-    acceleration, nonconservative, energy_of, factor, solve = (model.kernel(f) for f in (
-        accelerations, nonconservative_forces, mechanical_energy, factor_newton_matrix, solve_newton_matrix))
+    acceleration, energy_of, factor, solve = (model.kernel(f) for f in (
+        accelerations, mechanical_energy, factor_newton_matrix, solve_newton_matrix))
     free = np.ascontiguousarray(~model.held)
     mass = model.mass
     v = np.zeros_like(x)
@@ -236,7 +236,8 @@ def _solve(model, x: np.ndarray | None, tol: float, max_iterations: int, pose: n
     force, trial, other = np.zeros(nt), np.zeros(nt), np.zeros(nt)
     moving_fluid = bool(AT_REST_FORCES & model.switches)   # otherwise F_nc = 0 at rest: nothing to compile
     if moving_fluid:   # once before the first step too, so that `ropesim compile`'s one-iteration warm-up has it
-        nonconservative(x, v, acc, p, t, mass, free, other)
+        nonconservative = _nonconservative(model, acceleration, v, acc, t, free, junctions)
+        nonconservative(x, other)
     scale = _force_scale(model)
     worst, norm, energy = balance(x, pose, force)
     stiffest = max(line.stiffness for line in model.lines)
@@ -285,7 +286,7 @@ def _solve(model, x: np.ndarray | None, tol: float, max_iterations: int, pose: n
                 break
             continue
         if moving_fluid:
-            nonconservative(x, v, acc, p, t, mass, free, other)
+            nonconservative(x, other)
         drift = float(step @ other) + (own_drag if du is not None else 0.0)
         fraction, accepted = 1.0, False
         while fraction > 1e-6:
@@ -369,6 +370,29 @@ def _krylov_step(rhs: np.ndarray, inverse, extra, homogeneous=None) -> tuple[np.
     if offset_unknowns is None:
         return step, None
     return step, offset_unknowns + sum(c * u for c, u in zip(coefficients, unknowns))
+
+
+def _nonconservative(model, acceleration, v: np.ndarray, acc: np.ndarray, t: float, free: np.ndarray, junctions):
+    """F_nc at rest as ``forces(x, out)``: the non-conservative terms' force [N] on every free node into ``out``
+    (flat, node-major), a free point's on its first node.
+
+    With a flow the only such term (no sea, thrower or guides) it is the flow's drag on nodes at rest: the net
+    force in the flow less the net force in still water (:func:`~ropesim.model.forces.fluid.still_flow`), both
+    by the loop's own compiled term list, so nothing more is compiled (:func:`nonconservative_forces` was 0.7 s
+    of CPU of a first run). The difference is the drag to the round-off of the net force. Otherwise
+    :func:`nonconservative_forces`."""
+    p, mass = model.params, model.mass
+    if AT_REST_FORCES & model.switches != {WITH_FLOW.name}:
+        kernel = model.kernel(nonconservative_forces)
+        return lambda x, out: kernel(x, v, acc, p, t, mass, free, out)
+    still = p._replace(flow=still_flow(p.flow))
+    at_rest = np.zeros(v.size)
+
+    def forces(x: np.ndarray, out: np.ndarray) -> None:
+        forces_on_free_nodes(acceleration, x, v, acc, p, t, mass, free, out, junctions)
+        forces_on_free_nodes(acceleration, x, v, acc, still, t, mass, free, at_rest, junctions)
+        out -= at_rest
+    return forces
 
 
 @jit.kernel

@@ -51,6 +51,16 @@ def flow_at(y, t, flow, table):
     return flow_scaled(y, ramp(t, flow[1]), flow, table)
 
 
+def still_flow(flow: tuple) -> tuple:
+    """``flow`` (the parameters above) with no speed anywhere: the same profile and table heights, every
+    velocity 0, the same types (so a kernel compiled for the flow runs on it as it is)."""
+    scalars, table = flow
+    still_scalars, still_table = scalars.copy(), table.copy()
+    still_scalars[5:8] = 0.0
+    still_table[:, 1:] = 0.0
+    return still_scalars, still_table
+
+
 @jit.kernel
 def flow_scaled(y, s, flow, table):
     """The flow's full profile at height y [m] times s: its velocity with s the ramp's factor, its local
