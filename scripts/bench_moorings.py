@@ -606,7 +606,7 @@ def fluid_main(args) -> int:
     from references.moordyn_harness import moordyn_version
 
     started = time.perf_counter()
-    rhos = tuple(float(r) for r in args.fluid_rho.split(","))
+    rhos = args.fluid_rho
     results = []
     for name in args.fluid.split(","):
         print(f"{name}, {args.fluid_window:g} s ...", flush=True)
@@ -672,6 +672,17 @@ def sweep_main(args, started: float) -> int:
     return 0
 
 
+def rho_values(text: str) -> tuple[float, ...]:
+    """``--fluid-rho``'s comma-separated rho_inf values, each in [0, 1]."""
+    try:
+        values = tuple(float(r) for r in text.split(","))
+    except ValueError:
+        values = ()
+    if not values or not all(0.0 <= r <= 1.0 for r in values):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected comma-separated numbers in [0, 1], e.g. 0,0.3,0.5")
+    return values
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3, help="timed rounds (the fastest of each is kept)")
@@ -681,7 +692,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sweep-only", action="store_true", help="only the EA sweep (no MoorDyn, no WD0050 window)")
     parser.add_argument("--only", help="comma-separated ropesim methods to time (default: all; MoorDyn always)")
     parser.add_argument("--galpha-rho", type=float, default=0.0,
-                        help="galpha's rho_inf (default 0, the setting for moorings; galpha's own default is 0.9)")
+                        help="galpha's rho_inf (default 0, the setting for moorings; galpha's own default is 0.9); "
+                             "--fluid tries those of --fluid-rho instead")
     parser.add_argument("--own-seabed", action="store_true",
                         help="ropesim's own seabed damping (into the plane only) instead of MoorDyn's two-way law")
     parser.add_argument("--sweep-ea", default=",".join(f"{e:g}" for e in SWEEP_EA), help="EA values (N) to sweep")
@@ -690,9 +702,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--fluid", nargs="?", const="current,towed,catenary", default=None,
                         help="instead: galpha against MoorDyn on the equal-physics fluid cases (comma-separated)")
     parser.add_argument("--fluid-window", type=float, default=20.0, help="--fluid: simulated seconds per case")
-    parser.add_argument("--fluid-rho", default=",".join(f"{r:g}" for r in FLUID_RHO),
-                        help="--fluid: galpha's rho_inf values to try (comma-separated; each with every step and "
-                             "tolerance)")
+    parser.add_argument("--fluid-rho", type=rho_values, default=FLUID_RHO,
+                        help="--fluid: galpha's rho_inf values to try (comma-separated, each in [0, 1]; each with "
+                             "every step and tolerance; default " + ",".join(f"{r:g}" for r in FLUID_RHO) + ")")
     args = parser.parse_args(argv)
     SEABED["both_ways"] = not args.own_seabed
     GALPHA["rho_inf"] = args.galpha_rho
