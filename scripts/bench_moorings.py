@@ -36,15 +36,19 @@ window, each method's cheapest configuration reaching 1 % and 0.1 % against an r
     python scripts/bench_moorings.py [--repeats 3] [--window 120] [--points 4] [--no-sweep] \\
         [--json docs/data/moorings_speed.json] [--figure docs/images/moorings_speed.png]
 
-``--fluid`` instead times galpha (fixed steps and tolerances, ``--galpha-rho``) against MoorDyn's RK2 and RK4 on
-the three equal-physics fluid cases of tests/references/moordyn_equal_physics.py (current, towed, catenary; full
-size, their first ``--fluid-window`` seconds, no seabed), each code against its own RK4 at a small step, the
-error the top tension's RMS over its range; the cheapest configuration of each code at 1 % and 0.1 %:
+``--fluid`` instead times galpha (fixed steps and tolerances, six per decade from 0.1 to 1e-4 m, each at the
+rho_inf values of ``--fluid-rho``, default 0, 0.3 and 0.5) against MoorDyn's RK2 and RK4 on the three
+equal-physics fluid cases of tests/references/moordyn_equal_physics.py (current, towed, catenary; full size,
+their first ``--fluid-window`` seconds, no seabed), each code against its own RK4 at a small step, the error the
+top tension's RMS over its range; the cheapest configuration of each code at 1 % and 0.1 %:
 
-    python scripts/bench_moorings.py --fluid [current,towed,catenary] [--fluid-window 20] [--repeats 2]
+    python scripts/bench_moorings.py --fluid [current,towed,catenary] [--fluid-window 20] [--repeats 2] \
+        [--fluid-rho 0,0.3,0.5]
 
 The error counts the first seconds, where the current switches on (or the tow starts, or the catenary is
-released) at t = 0 and sets off axial waves; galpha at rho_inf 0 damps those in a step.
+released) at t = 0 and sets off axial waves. The towed line and the catenary ring at their first axial
+modes (about 100 rad/s, 1 % damped) for 2 to 4 s, and following that ringing's phase at 0.1 s samples is
+what sets galpha's steps there (about 1 ms); the catenary's release adds 80 to 140 us steps in its first 0.2 s.
 
 About 6 minutes on the shared 2-core machine at load average 1 to 2, 13 at load 4 to 6 (half without the sweep).
 """
@@ -463,12 +467,33 @@ def draw(rows: list[dict], sweep: list[dict], floor: float, path: Path, window: 
 
 # ------------------------------------------------------------------------------------------------ fluid cases
 
-#: galpha's configurations on the equal-physics fluid cases: fixed steps DT_OUT / k and tolerances [m]
+#: galpha's configurations on the equal-physics fluid cases: fixed steps DT_OUT / k and tolerances [m], six per
+#: decade (1, 1.5, 2, 3, 5, 7): with one per decade the cheapest tolerance reaching 1 % was up to 3x tighter than
+#: it needed to be (the cost grows about as tol^(-1/2)), each at every rho_inf of ``--fluid-rho``
 FLUID_GALPHA_KS = (1, 2, 4, 8, 16, 32)
-FLUID_GALPHA_TOLERANCES = (1e-1, 1e-2, 1e-3, 1e-4)
+FLUID_GALPHA_TOLERANCES = tuple(m * 10.0 ** e for e in (-2, -3, -4) for m in (7, 5, 3, 2, 1.5, 1)) + (1e-1,)
+#: rho_inf tried on the fluid cases. 0 is the moorings' setting (the steady current needs it: at 0.5 its top
+#: tension is 2.8 % off at tol 1e-2 against 0.11 %). The towed line and the catenary ring after their start, and
+#: their steps are set by following that ringing's phase: a smaller error constant |beta - 1/6 + (am - af) / 2|
+#: (0.33 at rho_inf 0, 0.16 at 0.3, 0.11 at 0.5) takes fewer steps at the same tension error (the towed line:
+#: 1886 steps at 0.3 against 2594 at 0, 0.96 and 1.0 %), until af grows the rejections (0.7 and 0.9: 3 to 8 times
+#: more on the towed line)
+FLUID_RHO = (0.0, 0.3, 0.5)
 #: MoorDyn's steps tried from the largest down (s); its largest stable RK2 step is 0.4 ms on the hanging line and
 #: 0.6 ms on the catenary (scripts/compare_moordyn.py), RK4's a little larger
 FLUID_MOORDYN_DTS = (8.0e-4, 6.0e-4, 5.0e-4, 4.0e-4, 3.0e-4, 2.0e-4)
+
+
+def galpha_label(rho: float, tol: float | None = None) -> str:
+    """A galpha configuration's method label: "galpha rho=R" (fixed steps) or "galpha rho=R tol=T"."""
+    return f"galpha rho={rho:g}" + ("" if tol is None else f" tol={tol:g}")
+
+
+def galpha_config(method: str) -> tuple[str, float | None, float | None]:
+    """(scheme, rho_inf or None, tolerance or None) of a method label (:func:`galpha_label`, or a plain name)."""
+    scheme, _, tol = method.partition(" tol=")
+    scheme, _, rho = scheme.partition(" rho=")
+    return scheme, (float(rho) if rho else None), (float(tol) if tol else None)
 
 
 def fluid_runs(name: str, window: float):
@@ -493,12 +518,12 @@ def fluid_runs(name: str, window: float):
             ok = out.top.size == frames and np.all(np.isfinite(out.top)) and np.all(np.isfinite(out.x))
             ok = ok and float(np.abs(out.x).max()) < 1e3
             return (out.top if ok else None), out.wall
-        scheme, _, tol = method.partition(" tol=")
+        scheme, rho, tol = galpha_config(method)
         d = ropesim_scene_dict(case, start, method=scheme, dt=dt)
         if scheme == "galpha":
-            d["integrator"]["rho_inf"] = GALPHA["rho_inf"]
-            if tol:
-                d["integrator"]["tolerance"] = float(tol)
+            d["integrator"]["rho_inf"] = GALPHA["rho_inf"] if rho is None else rho
+            if tol is not None:
+                d["integrator"]["tolerance"] = tol
         traj = ropesim.simulate(ropesim.scene_from_toml(tomli_w.dumps(d)))
         if traj.summary["status"] != "completed":
             return None, math.nan
@@ -507,7 +532,7 @@ def fluid_runs(name: str, window: float):
     return case, start, runner
 
 
-def fluid_case(name: str, window: float, repeats: int) -> dict:
+def fluid_case(name: str, window: float, repeats: int, rhos=FLUID_RHO) -> dict:
     """galpha against MoorDyn on one equal-physics case: each code's converged answer (its RK4 at a small step,
     checked against twice that step), every configuration timed ``repeats`` rounds (the fastest kept), the top
     tension's RMS error over the reference's range, and the cheapest configuration of each reaching 1 % and 0.1 %."""
@@ -528,8 +553,8 @@ def fluid_case(name: str, window: float, repeats: int) -> dict:
         refs[code] = fine
         ref_info[code] = {"method": method, "dt_s": dt, "check_dt_s": check, "check_rms_of_range":
                           float(np.sqrt(np.mean((fine[1:] - half[1:]) ** 2)) / np.ptp(fine[1:]))}
-    configs = [("ropesim", "galpha", step_of(k)) for k in FLUID_GALPHA_KS]
-    configs += [("ropesim", f"galpha tol={tol:g}", DT_OUT) for tol in FLUID_GALPHA_TOLERANCES]
+    configs = [("ropesim", galpha_label(rho), step_of(k)) for rho in rhos for k in FLUID_GALPHA_KS]
+    configs += [("ropesim", galpha_label(rho, tol), DT_OUT) for rho in rhos for tol in FLUID_GALPHA_TOLERANCES]
     for scheme in MOORDYN_SCHEMES:   # from the largest step that stays finite down
         stable = [dt for dt in FLUID_MOORDYN_DTS if runner("MoorDyn", scheme, dt)[0] is not None]
         configs += [("MoorDyn", scheme, dt) for dt in stable[:3]]
@@ -581,16 +606,17 @@ def fluid_main(args) -> int:
     from references.moordyn_harness import moordyn_version
 
     started = time.perf_counter()
+    rhos = args.fluid_rho
     results = []
     for name in args.fluid.split(","):
         print(f"{name}, {args.fluid_window:g} s ...", flush=True)
-        results.append(fluid_case(name, args.fluid_window, args.repeats))
+        results.append(fluid_case(name, args.fluid_window, args.repeats, rhos))
     try:
         load = os.getloadavg()
     except OSError:
         load = None
     out = {"made_by": "scripts/bench_moorings.py --fluid", "moordyn_version": moordyn_version(),
-           "galpha_rho_inf": GALPHA["rho_inf"], "load_average_after": load,
+           "galpha_rho_inf": list(rhos), "load_average_after": load,
            "accuracy": "RMS of the top tension's difference from the code's own converged answer over the window, "
                        "divided by that answer's range", "cases": results}
     args.json.parent.mkdir(parents=True, exist_ok=True)
@@ -646,6 +672,17 @@ def sweep_main(args, started: float) -> int:
     return 0
 
 
+def rho_values(text: str) -> tuple[float, ...]:
+    """``--fluid-rho``'s comma-separated rho_inf values, each in [0, 1]."""
+    try:
+        values = tuple(float(r) for r in text.split(","))
+    except ValueError:
+        values = ()
+    if not values or not all(0.0 <= r <= 1.0 for r in values):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected comma-separated numbers in [0, 1], e.g. 0,0.3,0.5")
+    return values
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3, help="timed rounds (the fastest of each is kept)")
@@ -655,7 +692,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sweep-only", action="store_true", help="only the EA sweep (no MoorDyn, no WD0050 window)")
     parser.add_argument("--only", help="comma-separated ropesim methods to time (default: all; MoorDyn always)")
     parser.add_argument("--galpha-rho", type=float, default=0.0,
-                        help="galpha's rho_inf (default 0, the setting for moorings; galpha's own default is 0.9)")
+                        help="galpha's rho_inf (default 0, the setting for moorings; galpha's own default is 0.9); "
+                             "--fluid tries those of --fluid-rho instead")
     parser.add_argument("--own-seabed", action="store_true",
                         help="ropesim's own seabed damping (into the plane only) instead of MoorDyn's two-way law")
     parser.add_argument("--sweep-ea", default=",".join(f"{e:g}" for e in SWEEP_EA), help="EA values (N) to sweep")
@@ -664,6 +702,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--fluid", nargs="?", const="current,towed,catenary", default=None,
                         help="instead: galpha against MoorDyn on the equal-physics fluid cases (comma-separated)")
     parser.add_argument("--fluid-window", type=float, default=20.0, help="--fluid: simulated seconds per case")
+    parser.add_argument("--fluid-rho", type=rho_values, default=FLUID_RHO,
+                        help="--fluid: galpha's rho_inf values to try (comma-separated, each in [0, 1]; each with "
+                             "every step and tolerance; default " + ",".join(f"{r:g}" for r in FLUID_RHO) + ")")
     args = parser.parse_args(argv)
     SEABED["both_ways"] = not args.own_seabed
     GALPHA["rho_inf"] = args.galpha_rho

@@ -335,8 +335,13 @@ def test_the_fluid_case_benchmark_runs(tmp_path):
     case = json.loads(out.read_text())["cases"][0]
     assert all(ref["check_rms_of_range"] < 1e-3 for ref in case["references"].values())
     codes = {(row["code"], row["method"].split(" tol=")[0]) for row in case["rows"] if row["ok"]}
-    assert codes == {("ropesim", "galpha"), ("MoorDyn", "RK2"), ("MoorDyn", "RK4")}
+    assert codes == {("ropesim", "galpha rho=0"), ("ropesim", "galpha rho=0.3"), ("ropesim", "galpha rho=0.5"),
+                     ("MoorDyn", "RK2"), ("MoorDyn", "RK4")}
+    tolerances = {row["method"].partition(" tol=")[2] for row in case["rows"] if " tol=" in row["method"]}
+    assert {"0.001", "0.0015", "0.002", "0.003", "0.005", "0.007"} <= tolerances   # six per decade
     assert set(case["cheapest"]) == {"0.01", "0.001"}
+    for target, per in case["cheapest"].items():   # each code's cheapest configuration reaches the target
+        assert all(v["error"] <= float(target) for v in per.values())
 
 
 @pytest.mark.slow
