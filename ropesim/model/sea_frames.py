@@ -19,10 +19,8 @@ from __future__ import annotations
 import numpy as np
 
 from .forces.sea import HALF_HI, HALF_LO, RADIUS, line_fraction
-from .waves import wave_field
+from .waves import compiled_tables, surface_at, wave_field
 from . import jit
-
-FRAME_CHUNK = 64   # frames whose elevation (frames x nodes x components) is summed at once
 
 
 def sea_shapes(model) -> dict[str, tuple]:
@@ -38,16 +36,23 @@ def sea_shapes(model) -> dict[str, tuple]:
 
 def elevation(scene, t: np.ndarray, x: np.ndarray, z: np.ndarray | float = 0.0) -> np.ndarray:
     """The surface's height above the mean level [m] at horizontal positions (x, z) and times t (broadcast
-    together), in chunks of frames (t's first axis); zeros without ``[waves]``."""
-    field = wave_field(scene)
+    together): :func:`surface` of the scene's waves; zeros without ``[waves]``."""
+    return surface(wave_field(scene), t, x, z)
+
+
+def surface(field, t: np.ndarray, x: np.ndarray, z: np.ndarray | float = 0.0) -> np.ndarray:
+    """The surface's height above the mean level [m] of the waves ``field`` (a
+    :class:`~ropesim.model.waves.WaveField`, or None: zeros) at horizontal positions (x, z) and times t
+    (broadcast together): the surface the forces see, by their own arithmetic
+    (:func:`ropesim.model.waves.surface_at`)."""
     t, x, z = np.broadcast_arrays(*(np.atleast_1d(np.asarray(a, dtype=float)) for a in (t, x, z)))
     out = np.zeros(t.shape)
-    if field is None:
+    if field is None or out.size == 0:
         return out
-    for a in range(0, len(t), FRAME_CHUNK):
-        part = slice(a, a + FRAME_CHUNK)
-        out[part] = field.elevation(x[part], t[part], z[part])
+    scalars, comps = compiled_tables(field)
+    surface_at(*(np.ascontiguousarray(a).reshape(-1) for a in (t, x, z)), scalars, comps, out.reshape(-1))
     return out
+
 
 def probe_elevation(scene, t: np.ndarray) -> np.ndarray:
     """(F, P) the surface's elevation [m] at the scene's probes (in the y-up frame the model computes in) at

@@ -433,6 +433,33 @@ def water_at(px, py, pz, t, scalars, comps):
     return (eta, r * uh0, r * uy, r * uh2, r * ah0 + rate * uh0, r * ay + rate * uy, r * ah2 + rate * uh2)
 
 
+@jit.kernel
+def surface_at(t, px, pz, scalars, comps, out):
+    """The surface's elevation above the mean level [m], the ramp included, at points (px, pz) [m] and times t
+    [s] (three 1-D arrays of one length) into ``out``: the surface the forces see, by the same arithmetic
+    (:func:`recurrence_kinematics`' first loop for a spectrum, :func:`water_at`'s for any other set), so a frame's
+    surface is bit for bit the one its forces were computed under. Points of one time in a row share that
+    time's factors (:func:`time_factors`); per point, four sines and cosines and a complex multiplication per
+    component (a spectrum) or a sine and cosine per component (a table)."""
+    recur = scalars[MODE] == RECURRENCE
+    k0, dk, cb, sb = scalars[K0], scalars[DK], scalars[DIR_COS], scalars[DIR_SIN]
+    for p in range(t.shape[0]):
+        time_factors(scalars, comps, t[p])
+        eta = 0.0
+        if recur:
+            xp = px[p] * cb - pz[p] * sb
+            c, s = math.cos(k0 * xp), math.sin(k0 * xp)
+            cr, sr = math.cos(dk * xp), math.sin(dk * xp)
+            for j in range(comps.shape[1]):
+                eta += comps[AMP, j] * (c * comps[TIME_COS, j] - s * comps[TIME_SIN, j])
+                c, s = c * cr - s * sr, c * sr + s * cr
+        else:
+            for j in range(comps.shape[1]):
+                theta = comps[K, j] * (px[p] * comps[COS_DIR, j] - pz[p] * comps[SIN_DIR, j])
+                eta += comps[AMP, j] * (math.cos(theta) * comps[TIME_COS, j] - math.sin(theta) * comps[TIME_SIN, j])
+        out[p] = eta * ramp(t[p], scalars[RAMP_TIME])
+
+
 NODE_ROWS = 13
 """Scratch rows per node of :func:`node_kinematics` (see there)."""
 (W_C, W_S, W_CR, W_SR, W_E1, W_R1, W_E2, W_R2, W_UH, W_UY, W_AH, W_AY, W_XP) = range(NODE_ROWS)
