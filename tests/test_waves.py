@@ -302,17 +302,18 @@ def test_the_frames_surface_is_the_forces_own(kind, dim):
     x = np.vstack([rng.uniform(-100, 100, n), rng.uniform(-24, 1, n)] + ([rng.uniform(-100, 100, n)] if dim == 3
                                                                       else []))
     z = x[2] if dim == 3 else np.zeros(n)
-    times = np.array([250.0, 0.0, 3.7, 3.7, 11.0])
+    times = np.array([250.0, 0.0, 3.7, 3.7, 11.0])   # frames in any order, one twice
     scalars, comps = W.compiled_tables(field)
     got = np.empty(times.size * n)
-    W.surface_at(np.repeat(times, n), np.tile(x[0], times.size), np.tile(z, times.size), scalars, comps, got)
+    W.surface_at(np.repeat(times, n), np.tile(x[0], times.size), np.tile(z, times.size), scalars, comps,
+                 np.empty((W.SURFACE_ROWS, got.size)), got)
     got = got.reshape(times.size, n)
     for k, t in enumerate(times):
         forces, _ = _compiled(field, x, t)
         assert np.array_equal(got[k], forces[0])
         assert np.allclose(got[k], field.elevation(x[0], t, z), rtol=0, atol=1e-12)
 
-    framed = surface(field, times[:, None], x[0][None, :], z[None, :])   # (frames, nodes), broadcast
+    framed = surface(W.compiled_tables(field), times[:, None], x[0][None, :], z[None, :])   # (frames, nodes)
     assert np.array_equal(framed, got)
 
 

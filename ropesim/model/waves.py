@@ -433,31 +433,54 @@ def water_at(px, py, pz, t, scalars, comps):
     return (eta, r * uh0, r * uy, r * uh2, r * ah0 + rate * uh0, r * ay + rate * uy, r * ah2 + rate * uh2)
 
 
+SURFACE_ROWS = 4
+"""Scratch rows per point of :func:`surface_at`."""
+
+
 @jit.kernel
-def surface_at(t, px, pz, scalars, comps, out):
+def surface_at(t, px, pz, scalars, comps, work, out):
     """The surface's elevation above the mean level [m], the ramp included, at points (px, pz) [m] and times t
-    [s] (three 1-D arrays of one length) into ``out``: the surface the forces see, by the same arithmetic
-    (:func:`recurrence_kinematics`' first loop for a spectrum, :func:`water_at`'s for any other set), so a frame's
-    surface is bit for bit the one its forces were computed under. Points of one time in a row share that
-    time's factors (:func:`time_factors`); per point, four sines and cosines and a complex multiplication per
-    component (a spectrum) or a sine and cosine per component (a table)."""
+    [s] (three 1-D arrays of one length P) into ``out``; ``work`` (SURFACE_ROWS, P) is scratch. The surface the
+    forces see, by the same arithmetic (:func:`recurrence_kinematics`' first loop for a spectrum, vectorised over
+    each run of points at one time, as there over the nodes; :func:`water_at`'s for any other set), so a
+    frame's surface is bit for bit the one its forces were computed under. A run of points at one time shares
+    that time's factors (:func:`time_factors`)."""
     recur = scalars[MODE] == RECURRENCE
     k0, dk, cb, sb = scalars[K0], scalars[DK], scalars[DIR_COS], scalars[DIR_SIN]
-    for p in range(t.shape[0]):
-        time_factors(scalars, comps, t[p])
-        eta = 0.0
+    c, s, cr, sr = work[0], work[1], work[2], work[3]
+    total = t.shape[0]
+    first = 0
+    while first < total:
+        now = t[first]
+        end = first + 1
+        while end < total and t[end] == now:
+            end += 1
+        time_factors(scalars, comps, now)
+        r = ramp(now, scalars[RAMP_TIME])
         if recur:
-            xp = px[p] * cb - pz[p] * sb
-            c, s = math.cos(k0 * xp), math.sin(k0 * xp)
-            cr, sr = math.cos(dk * xp), math.sin(dk * xp)
+            for p in range(first, end):
+                xp = px[p] * cb - pz[p] * sb
+                c[p], s[p] = math.cos(k0 * xp), math.sin(k0 * xp)
+                cr[p], sr[p] = math.cos(dk * xp), math.sin(dk * xp)
+                out[p] = 0.0
             for j in range(comps.shape[1]):
-                eta += comps[AMP, j] * (c * comps[TIME_COS, j] - s * comps[TIME_SIN, j])
-                c, s = c * cr - s * sr, c * sr + s * cr
+                amp, tc, ts = comps[AMP, j], comps[TIME_COS, j], comps[TIME_SIN, j]
+                for p in range(first, end):
+                    cp, sp = c[p], s[p]
+                    out[p] += amp * (cp * tc - sp * ts)
+                    c[p] = cp * cr[p] - sp * sr[p]
+                    s[p] = cp * sr[p] + sp * cr[p]
         else:
-            for j in range(comps.shape[1]):
-                theta = comps[K, j] * (px[p] * comps[COS_DIR, j] - pz[p] * comps[SIN_DIR, j])
-                eta += comps[AMP, j] * (math.cos(theta) * comps[TIME_COS, j] - math.sin(theta) * comps[TIME_SIN, j])
-        out[p] = eta * ramp(t[p], scalars[RAMP_TIME])
+            for p in range(first, end):
+                eta = 0.0
+                for j in range(comps.shape[1]):
+                    theta = comps[K, j] * (px[p] * comps[COS_DIR, j] - pz[p] * comps[SIN_DIR, j])
+                    eta += comps[AMP, j] * (math.cos(theta) * comps[TIME_COS, j]
+                                            - math.sin(theta) * comps[TIME_SIN, j])
+                out[p] = eta
+        for p in range(first, end):
+            out[p] *= r
+        first = end
 
 
 NODE_ROWS = 13
