@@ -283,6 +283,40 @@ def test_compiled_kinematics_match_the_reference(kind, dim):
         assert np.allclose(out[4:7].T, du, rtol=0, atol=1e-11 * np.abs(du).max() + 1e-300)
 
 
+@pytest.mark.parametrize("kind", ["spectrum", "table"])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_the_frames_surface_is_the_forces_own(kind, dim):
+    """The saved frames' surface (sea_frames.surface, W.surface_at) is, bit for bit, the eta the compiled forces
+    computed at the same nodes and time, and within rounding of the NumPy reference, ramp included, at any mix of
+    times and positions, frames in any order."""
+    from ropesim.model.sea_frames import surface
+
+    if kind == "table":   # evaluated component by component (two directions in 3-D)
+        c = W.table_components([(0.4, 0.6, 30.0, 0.0), (0.3, 0.9, 100.0, 0.0 if dim == 2 else 40.0)], 25.0, G)
+    else:
+        c = W.spectral_components(4.0, 9.0, 3.3, 200, W.default_range(9.0), 25.0, G, seed=2,
+                                  direction=0.0 if dim == 2 else 0.7)
+    field = W.WaveField(c, level=0.0, depth=25.0, g=G, ramp_time=10.0)
+    rng = np.random.default_rng(3)
+    n = 40
+    x = np.vstack([rng.uniform(-100, 100, n), rng.uniform(-24, 1, n)] + ([rng.uniform(-100, 100, n)] if dim == 3
+                                                                      else []))
+    z = x[2] if dim == 3 else np.zeros(n)
+    times = np.array([250.0, 0.0, 3.7, 3.7, 11.0])   # frames in any order, one twice
+    scalars, comps = W.compiled_tables(field)
+    got = np.empty(times.size * n)
+    W.surface_at(np.repeat(times, n), np.tile(x[0], times.size), np.tile(z, times.size), scalars, comps,
+                 np.empty((W.SURFACE_ROWS, got.size)), got)
+    got = got.reshape(times.size, n)
+    for k, t in enumerate(times):
+        forces, _ = _compiled(field, x, t)
+        assert np.array_equal(got[k], forces[0])
+        assert np.allclose(got[k], field.elevation(x[0], t, z), rtol=0, atol=1e-12)
+
+    framed = surface(W.compiled_tables(field), times[:, None], x[0][None, :], z[None, :])   # (frames, nodes)
+    assert np.array_equal(framed, got)
+
+
 def test_compiled_time_factors_are_shared_and_exact_after_a_jump():
     """The cached time factors hold one time: a later call at another time recomputes them, and going back gives
     bit for bit what the first call gave (the numbers depend on (x, t) alone)."""

@@ -62,6 +62,7 @@ from ..model import jit
 from ..model.banded import factor, solve, woodbury
 from ..model.forces.added_mass import added_mass_times
 from ..model.forces.seabed import WITH_SEABED, depth
+from ..model.forces.sea import WITH_WAVES, hold_waves
 from ..model.jacobian import Jacobian, band_width
 from ..model.bodies import WITH_BODIES, place_attachments
 from ..model.junctions import (WITH_JUNCTIONS, add_junction_added_mass_jacobian, fold_junctions,
@@ -547,7 +548,11 @@ def advance_galpha(state, work, newton, co, held, nodes, params, limits, schedul
         step_start(x, v, an, work, co, h)
         if WITH_BODIES:
             step_start_bodies(newton.body, bodies.pose, bodies.twist, co, h)
+        if WITH_WAVES:
+            hold_waves(params, True)
         its, node, fluid, internal, seabed = solve_step(work, newton, co, t, h, held, nodes, params, control, stats)
+        if WITH_WAVES:
+            hold_waves(params, False)
         if its < 0:
             return s, frame, NEWTON_FAILED, node
         if WITH_BODIES:
@@ -616,8 +621,12 @@ def advance_adaptive(state, work, newton, co, held, nodes, params, limits, sched
                 step_start(x1, v1, an, work, co, h)
                 if WITH_BODIES:
                     step_start_bodies(newton.body, newton.body.pose1, newton.body.twist1, co, h)
+                if WITH_WAVES:
+                    hold_waves(params, True)
                 its, node, fluid, internal, seabed = solve_step(work, newton, co, t, h, held, nodes, params,
                                                                 control, stats)
+                if WITH_WAVES:
+                    hold_waves(params, False)
                 if its < 0:
                     counts[REJECTED] += 1
                     h *= NEWTON_SHRINK

@@ -19,10 +19,8 @@ from __future__ import annotations
 import numpy as np
 
 from .forces.sea import HALF_HI, HALF_LO, RADIUS, line_fraction
-from .waves import wave_field
+from .waves import SURFACE_ROWS, WAVE_SCALARS, compiled_tables, surface_at, wave_field
 from . import jit
-
-FRAME_CHUNK = 64   # frames whose elevation (frames x nodes x components) is summed at once
 
 
 def sea_shapes(model) -> dict[str, tuple]:
@@ -38,16 +36,33 @@ def sea_shapes(model) -> dict[str, tuple]:
 
 def elevation(scene, t: np.ndarray, x: np.ndarray, z: np.ndarray | float = 0.0) -> np.ndarray:
     """The surface's height above the mean level [m] at horizontal positions (x, z) and times t (broadcast
-    together), in chunks of frames (t's first axis); zeros without ``[waves]``."""
+    together): :func:`surface` of the scene's waves; zeros without ``[waves]``."""
     field = wave_field(scene)
+    return surface(None if field is None else compiled_tables(field), t, x, z)
+
+
+def surface(tables, t: np.ndarray, x: np.ndarray, z: np.ndarray | float = 0.0) -> np.ndarray:
+    """The surface's height above the mean level [m] of the waves whose compiled ``tables`` (scalars, comps) are
+    given (:func:`ropesim.model.waves.compiled_tables`; None: no waves, zeros) at horizontal positions (x, z) and
+    times t (broadcast together): the surface the forces see, by their own arithmetic
+    (:func:`ropesim.model.waves.surface_at`). The tables' time factors are scratch."""
     t, x, z = np.broadcast_arrays(*(np.atleast_1d(np.asarray(a, dtype=float)) for a in (t, x, z)))
     out = np.zeros(t.shape)
-    if field is None:
+    if tables is None or out.size == 0:
         return out
-    for a in range(0, len(t), FRAME_CHUNK):
-        part = slice(a, a + FRAME_CHUNK)
-        out[part] = field.elevation(x[part], t[part], z[part])
+    surface_at(*(np.ascontiguousarray(a).reshape(-1) for a in (t, x, z)), *tables,
+               np.empty((SURFACE_ROWS, out.size)), out.reshape(-1))
     return out
+
+
+def model_tables(model):
+    """A copy of the model's own compiled wave tables (its sea's), or None without ``[waves]``: the frames'
+    surface without rebuilding the spectrum for every chunk of frames."""
+    if model.scene.sea is None or model.scene.waves is None:
+        return None
+    sea = model.params.sea
+    return sea.scalars[:WAVE_SCALARS].copy(), sea.comps.copy()
+
 
 def probe_elevation(scene, t: np.ndarray) -> np.ndarray:
     """(F, P) the surface's elevation [m] at the scene's probes (in the y-up frame the model computes in) at
@@ -66,10 +81,10 @@ def sea_frames(model, t: np.ndarray, x: np.ndarray) -> dict[str, np.ndarray]:
     t = np.asarray(t, dtype=float)
     x = np.asarray(x, dtype=float)
     z = x[..., 2] if x.shape[2] == 3 else 0.0
-    surface = scene.sea.level + elevation(scene, t[:, None], x[..., 0], z)
+    level = scene.sea.level + surface(model_tables(model), t[:, None], x[..., 0], z)
     nodes = model.params.sea.nodes
     submerged = np.empty(x.shape[:2])
-    node_fractions(np.ascontiguousarray(np.swapaxes(x, 1, 2)), surface, model.params.neighbours, nodes, submerged)
+    node_fractions(np.ascontiguousarray(np.swapaxes(x, 1, 2)), level, model.params.neighbours, nodes, submerged)
     weight = nodes[HALF_LO] + nodes[HALF_HI]
     lines = np.empty((len(t), len(model.lines)))
     for k, line in enumerate(model.lines):

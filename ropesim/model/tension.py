@@ -82,10 +82,13 @@ def held_forces(model, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> tuple[np.
     if m.moving:   # the prescribed accelerations a_p, as the loops compute them
         held = Held(idx, model.held_x0, model.held_v.copy(), m._replace(accel=np.zeros_like(m.accel)))
         prescribed = model.kernel(place_moving)
+    dragged = bool(np.any(model.drag[idx]))   # a linear [drag] on a held node (none: nothing to add)
     for k in range(len(t)):
         xk, vk = np.ascontiguousarray(np.asarray(x[k]).T), np.ascontiguousarray(np.asarray(v[k]).T)
         forces(xk, vk, acc, model.params, float(t[k]))
-        net[k] = mass * acc[:, idx].T + held_linear_drag(model, float(t[k]), xk, vk)
+        net[k] = mass * acc[:, idx].T
+        if dragged:
+            net[k] += held_linear_drag(model, float(t[k]), xk, vk)
         out[k] = -net[k]
         if m.moving:
             prescribed(xk.copy(), vk.copy(), held, float(t[k]), float(t[k]))

@@ -433,6 +433,56 @@ def water_at(px, py, pz, t, scalars, comps):
     return (eta, r * uh0, r * uy, r * uh2, r * ah0 + rate * uh0, r * ay + rate * uy, r * ah2 + rate * uh2)
 
 
+SURFACE_ROWS = 4
+"""Scratch rows per point of :func:`surface_at`."""
+
+
+@jit.kernel
+def surface_at(t, px, pz, scalars, comps, work, out):
+    """The surface's elevation above the mean level [m], the ramp included, at points (px, pz) [m] and times t
+    [s] (three 1-D arrays of one length P) into ``out``; ``work`` (SURFACE_ROWS, P) is scratch. The surface the
+    forces see, by the same arithmetic (:func:`recurrence_kinematics`' first loop for a spectrum, vectorised over
+    each run of points at one time, as there over the nodes; :func:`water_at`'s for any other set), so a
+    frame's surface is bit for bit the one its forces were computed under. A run of points at one time shares
+    that time's factors (:func:`time_factors`)."""
+    recur = scalars[MODE] == RECURRENCE
+    k0, dk, cb, sb = scalars[K0], scalars[DK], scalars[DIR_COS], scalars[DIR_SIN]
+    c, s, cr, sr = work[0], work[1], work[2], work[3]
+    total = t.shape[0]
+    first = 0
+    while first < total:
+        now = t[first]
+        end = first + 1
+        while end < total and t[end] == now:
+            end += 1
+        time_factors(scalars, comps, now)
+        r = ramp(now, scalars[RAMP_TIME])
+        if recur:
+            for p in range(first, end):
+                xp = px[p] * cb - pz[p] * sb
+                c[p], s[p] = math.cos(k0 * xp), math.sin(k0 * xp)
+                cr[p], sr[p] = math.cos(dk * xp), math.sin(dk * xp)
+                out[p] = 0.0
+            for j in range(comps.shape[1]):
+                amp, tc, ts = comps[AMP, j], comps[TIME_COS, j], comps[TIME_SIN, j]
+                for p in range(first, end):
+                    cp, sp = c[p], s[p]
+                    out[p] += amp * (cp * tc - sp * ts)
+                    c[p] = cp * cr[p] - sp * sr[p]
+                    s[p] = cp * sr[p] + sp * cr[p]
+        else:
+            for p in range(first, end):
+                eta = 0.0
+                for j in range(comps.shape[1]):
+                    theta = comps[K, j] * (px[p] * comps[COS_DIR, j] - pz[p] * comps[SIN_DIR, j])
+                    eta += comps[AMP, j] * (math.cos(theta) * comps[TIME_COS, j]
+                                            - math.sin(theta) * comps[TIME_SIN, j])
+                out[p] = eta
+        for p in range(first, end):
+            out[p] *= r
+        first = end
+
+
 NODE_ROWS = 13
 """Scratch rows per node of :func:`node_kinematics` (see there)."""
 (W_C, W_S, W_CR, W_SR, W_E1, W_R1, W_E2, W_R2, W_UH, W_UY, W_AH, W_AY, W_XP) = range(NODE_ROWS)
