@@ -466,12 +466,6 @@ def _solve6(work, r0, r1, r2, r3, r4, r5):
     return x0, x1, x2, x3, x4, x5
 
 
-@jit.kernel(inline="always")
-def _row6(m, i, r0, r1, r2, r3, r4, r5):
-    """Row i of a 6 x 6 matrix ``m`` times r, summed from 0 as :func:`_times_inverse` sums."""
-    return 0.0 + m[i, 0] * r0 + m[i, 1] * r1 + m[i, 2] * r2 + m[i, 3] * r3 + m[i, 4] * r4 + m[i, 5] * r5
-
-
 @jit.kernel
 def own_load(gravity, flow, bodies, pose, twist, b, t, r):
     """Body b's own force [N] and moment [N m] about its reference point, in its axes (R^T of the world's): its
@@ -659,30 +653,31 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
                 g0, g1, g2 = g0 - along * d0, g1 - along * d1, g2 - along * d2
             h0, h1, h2 = cross(s0, s1, s2, g0, g1, g2)
             f0, f1, f2, m0, m1, m2 = f0 + g0, f1 + g1, f2 + g2, m0 + h0, m1 + h1, m2 + h2
-        if n == 6:   # 3-D: the same solve written out in scalars (_factor6)
-            if moved and varies:
+        if moved and varies:
+            if n == 6:   # 3-D: written out in scalars, the same numbers (_factor6)
                 _factor6(work, bodies.matrices[b, CONSTANT], links, k_first, k_end)
-            if varies:
-                ab0, ab1, ab2, alb0, alb1, alb2 = _solve6(work, f0, f1, f2, m0, m1, m2)
-            else:   # the constant matrix's inverse times the right-hand side
-                inverse = bodies.matrices[b, INVERSE]
-                ab0, ab1, ab2 = (_row6(inverse, 0, f0, f1, f2, m0, m1, m2), _row6(inverse, 1, f0, f1, f2, m0, m1, m2),
-                                 _row6(inverse, 2, f0, f1, f2, m0, m1, m2))
-                alb0, alb1, alb2 = (_row6(inverse, 3, f0, f1, f2, m0, m1, m2),
-                                    _row6(inverse, 4, f0, f1, f2, m0, m1, m2),
-                                    _row6(inverse, 5, f0, f1, f2, m0, m1, m2))
-        else:   # 2-D: x, y and the turn about z
-            if moved and varies:
+            else:
                 _varying_mass(work, bodies.matrices[b, CONSTANT], n, links, k_first, k_end)
                 _ldl_factor(work, n)
-            work[0, 6], work[1, 6], work[2, 6] = f0, f1, m2   # the kept rows' right-hand side
+        if varies and n == 6:
+            ab0, ab1, ab2, alb0, alb1, alb2 = _solve6(work, f0, f1, f2, m0, m1, m2)
+        else:
+            work[0, 6], work[1, 6] = f0, f1   # the kept rows' right-hand side: x, y and the turn about z in 2-D
+            if n == 3:
+                work[2, 6] = m2
+            else:
+                work[2, 6], work[3, 6], work[4, 6], work[5, 6] = f2, m0, m1, m2
             if varies:
                 _ldl_solve(work, n, work)
                 at = 6
             else:   # the constant matrix's inverse times the right-hand side, into the unused first column
                 _times_inverse(bodies.matrices[b, INVERSE], n, work)
                 at = 0
-            ab0, ab1, ab2, alb0, alb1, alb2 = work[0, at], work[1, at], 0.0, 0.0, 0.0, work[2, at]
+            if n == 3:   # 2-D: x, y and the turn about z
+                ab0, ab1, ab2, alb0, alb1, alb2 = work[0, at], work[1, at], 0.0, 0.0, 0.0, work[2, at]
+            else:
+                ab0, ab1, ab2, alb0, alb1, alb2 = work[0, at], work[1, at], work[2, at], work[3, at], work[4, at], \
+                    work[5, at]
         out[0, b], out[1, b], out[2, b] = rotate(r, ab0, ab1, ab2)
         out[3, b], out[4, b], out[5, b] = rotate(r, alb0, alb1, alb2)
         # the fluid's inertial force on the body's own added mass: -A_t a . v - A_r alpha . w
