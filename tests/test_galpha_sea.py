@@ -127,3 +127,43 @@ def test_holding_the_waves_moves_the_answer_far_less_than_the_scheme_errs(rho):
     assert error > 1e-4
     assert np.max(np.abs(held.x - fresh.x)) < 1e-3 * error
     assert held.force_evaluations <= fresh.force_evaluations + 5
+
+
+def test_the_sea_benchmarks_measure_is_the_rms_error_over_the_tensions_range():
+    """scripts/bench_waves.py --chain's error measures on a made-up record: a 1000 kN pull swinging by 10 kN
+    (range 20 kN, deviation 10 / sqrt 2), and a candidate 200 N off throughout: 1 % of the range (RMS), 0.02 %
+    of the peak, 2.8 % of the deviation. The first tenth (the waves' ramp) is left out of the RMS and the range,
+    not of the largest error."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "scripts"))
+    from bench_waves import errors
+
+    t = np.linspace(0.0, 300.0, 15001)
+    reference = 1.0e6 + 1.0e4 * np.sin(2 * np.pi * t / 10.0)
+    reference[:100] = 0.0   # within the first tenth: not the waves' swing
+    of_range, of_peak, of_std = errors(reference + 200.0, reference)
+    assert of_range == pytest.approx(0.01, rel=1e-3)
+    assert of_peak == pytest.approx(200.0 / 1.01e6, rel=1e-3)
+    assert of_std == pytest.approx(200.0 / (1.0e4 / np.sqrt(2.0)), rel=1e-3)
+
+
+@pytest.mark.slow
+def test_the_sea_benchmark_runs():
+    """scripts/bench_waves.py --chain over a 6 s window, galpha at rho_inf 0.9 alone: its ladder, the measure's
+    three columns and the fastest candidate within 1 % of the range."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parent.parent / "scripts" / "bench_waves.py"
+    result = subprocess.run([sys.executable, str(script), "--chain", "--window", "6", "--methods", "galpha",
+                             "--galpha-rho", "0.9", "--no-sweep"], capture_output=True, text=True, timeout=1800,
+                            env={**os.environ, "COLUMNS": "200"})
+    assert result.returncode == 0, result.stderr[-2000:]
+    out = result.stdout
+    assert "RMS error / range" in out and "largest error / peak" in out and "RMS error / std" in out
+    assert out.count("galpha rho 0.9") >= 4
+    assert "fastest within 1 % of the tension's range (RMS): galpha rho 0.9" in out

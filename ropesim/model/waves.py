@@ -35,9 +35,10 @@ Three kinds of component sets:
 - a table (:func:`table_components`): the user's components (amplitude, frequency, phase, direction), any
   frequencies and directions.
 
-:class:`WaveField` evaluates the formulas with NumPy, component by component (the reference: outputs, pictures,
-tests). The compiled kernels (:func:`node_kinematics`, :func:`water_at`) evaluate the same formulas from the
-tables :func:`compiled_tables` makes.
+:class:`WaveField` evaluates the formulas with NumPy, component by component (the reference: the tests, the
+viewer's drawn surface, a body's outputs). The compiled kernels (:func:`node_kinematics`, :func:`water_at`, and
+:func:`surface_at` for the saved frames' surface, the probes and the pictures) evaluate the same formulas from
+the tables :func:`compiled_tables` makes.
 
 **Cost.** The time factors e^(i (phi_j - w_j t)) are computed once per time (J sines and cosines, cached, so
 every node and every Newton iteration at that time shares them: :func:`time_factors`). For a spectrum the node's
@@ -256,8 +257,8 @@ def steepest(components: Components) -> tuple[float, int]:
 @dataclass(frozen=True)
 class WaveField:
     """A sea's waves for NumPy: its components, the mean level [m], depth [m] (inf: deep), g, ramp time [s]
-    and stretching ("wheeler" or "vertical"). The outputs (probes, the surface drawn, submerged fractions)
-    and the tests evaluate it; the compiled kernels evaluate the same formulas (module doc)."""
+    and stretching ("wheeler" or "vertical"). The tests, the viewer's surface and a body's outputs evaluate
+    it; the compiled kernels evaluate the same formulas (module doc)."""
 
     components: Components
     level: float
