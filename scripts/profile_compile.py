@@ -15,7 +15,9 @@ the functions compiled at the top level (what the run asked for) and the LLVM sh
 ``--passes`` adds where the compile goes by stage, summed over every function: each of Numba's compiler
 passes (type inference, lowering to LLVM IR, ...), the wrappers Numba lowers for calls from Python, and
 LLVM's stages (function passes, each library's final module, machine-code emission), each stage's own CPU
-seconds (what a nested stage spent left out, so the rows add up to the compile).
+seconds (what a nested stage spent left out, so the rows add up to the compile); then the largest
+(function, stage) pairs, each stage charged to the function whose compile ran it (a loop's final module and
+machine code hold every callee linked in; a ``__i`` twin's are never run).
 
 Figures are CPU seconds of one process: compare them with each other, or with another revision's in the
 same load (``scripts/bench_first_run.py`` measures whole first runs against another revision).
@@ -73,7 +75,7 @@ def main() -> None:
 
     event.register("numba:compile", Compiles())
     event.register("numba:llvm_lock", Llvm())
-    stages = time_stages() if args.passes else {}
+    stages, by_function = time_stages(stack) if args.passes else ({}, {})
     from ropesim.cli import main as ropesim_main
 
     command = ["run", args.scene, "--set", f"integrator.t_end={args.t_end}", "--out", os.path.join(work, "run"),
@@ -102,15 +104,20 @@ def main() -> None:
         print("by stage (own CPU seconds, summed over every function):")
         for name, seconds in sorted(stages.items(), key=lambda item: -item[1])[:args.top]:
             print(f"{seconds:7.2f}  {name}")
+        print("by function and stage (the largest; own CPU seconds):")
+        for (function, name), seconds in sorted(by_function.items(), key=lambda item: -item[1])[:args.top]:
+            print(f"{seconds:7.2f}  {function.rsplit('.', 1)[-1]:<40} {name}")
 
 
-def time_stages() -> dict:
+def time_stages(compiling: list) -> tuple[dict, dict]:
     """Wrap Numba's compiler passes, the wrappers' lowering and its code library's LLVM stages to sum each one's
     own CPU seconds (a stage nested in another, such as a callee's compile inside its caller's type inference,
-    is left out of the outer one) into the dict returned, filled as the run compiles."""
+    is left out of the outer one) into the first dict returned, and per (function, stage) into the second, the
+    function the innermost compile on ``compiling`` (the compile events' stack); both filled as the run
+    compiles."""
     from numba.core import codegen, compiler_machinery, lowering
 
-    own, stack = {}, []
+    own, by_function, stack = {}, {}, []
 
     def timed(name, method):
         def run(*args, **kwargs):
@@ -121,6 +128,8 @@ def time_stages() -> dict:
                 start, nested = stack.pop()
                 spent = time.process_time() - start
                 own[name] = own.get(name, 0.0) + spent - nested
+                key = (compiling[-1][0] if compiling else "(none)", name)
+                by_function[key] = by_function.get(key, 0.0) + spent - nested
                 if stack:
                     stack[-1][1] += spent
         return run
@@ -139,7 +148,7 @@ def time_stages() -> dict:
             (codegen.CPUCodeLibrary, "_optimize_final_module", "LLVM final module (callees linked in)"),
             (codegen.JITCodeLibrary, "_finalize_specific", "LLVM machine code")]:
         setattr(cls, method, timed(name, getattr(cls, method)))
-    return own
+    return own, by_function
 
 
 if __name__ == "__main__":
