@@ -152,11 +152,12 @@ class SdirkFamily(Integrator):
                 self.model.params, self.limits, self.schedule(n), frames, self.bodies)
 
 
-@jit.kernel
+@jit.kernel(inline="always")
 def stage_velocities(stage, beta, held, params, body, groups):
     """The stage's velocities V = (X - xh) / beta at its positions X (held nodes: their own velocity; a free
     body's line ends where its stage pose puts them), the state at which :func:`stage_residual` takes the
-    accelerations."""
+    accelerations. Inlined: a call hands over the parameter bundle by value, which a small rope's Newton
+    iteration would feel."""
     xh, X, V = stage.xh, stage.X, stage.V
     held_idx, held_v = held.idx, held.v
     dim, n = X.shape
