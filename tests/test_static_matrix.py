@@ -138,7 +138,8 @@ def test_either_matrix_finds_the_same_static_shape_in_as_many_iterations(raw):
 def test_an_explicit_static_start_compiles_no_newton_matrix(tmp_path):
     """With an empty cache, an rk4 mooring line's static start compiles none of the analytic matrix's kernels,
     nor the drag's tangent stiffness, nor (no flow: nothing non-conservative at rest) the merit's
-    non-conservative forces; sdirk2's compiles the matrix its loop uses anyway."""
+    non-conservative forces; sdirk2's compiles the matrix its loop uses anyway, and still no tangent stiffness of
+    the drag (zero at rest without a flow)."""
     code = f"""
         import ropesim, tomli_w
         from ropesim.model.build import build
@@ -155,6 +156,7 @@ def test_an_explicit_static_start_compiles_no_newton_matrix(tmp_path):
         assert kernel not in names, kernel
     implicit = _probe(code.replace('"rk4"', '"sdirk2"'), tmp_path / "cache")
     assert "newton_matrix" in implicit
+    assert "add_fluid_tangent_stiffness" not in implicit and "nonconservative_forces" not in implicit
 
 
 def test_a_stalled_differenced_solve_starts_again_with_the_analytic_matrix(monkeypatch):

@@ -152,16 +152,14 @@ class SdirkFamily(Integrator):
                 self.model.params, self.limits, self.schedule(n), frames, self.bodies)
 
 
-@jit.kernel
-def stage_residual(stage, rhs, beta, t_stage, held, nodes, params, body, groups):
-    """At the stage's positions X, with V = (X - xh) / beta (held nodes: their own velocity; a free body's line
-    ends where its stage pose puts them), write minus the residual of m (V - vh) = beta (a(X, V) m - b V) (plus
-    A_i (V - vh) with added mass), times beta, into ``rhs`` (a body's: its own, into its group's, see
-    :mod:`ropesim.integrate.sdirk_bodies`). Returns (its squared norm, fluid, internal-damping and seabed power
-    [W])."""
-    xh, vh, X, V, acc = stage.xh, stage.vh, stage.X, stage.V, stage.acc
+@jit.kernel(inline="always")
+def stage_velocities(stage, beta, held, params, body, groups):
+    """The stage's velocities V = (X - xh) / beta at its positions X (held nodes: their own velocity; a free
+    body's line ends where its stage pose puts them), the state at which :func:`stage_residual` takes the
+    accelerations. Inlined: a call hands over the parameter bundle by value, which a small rope's Newton
+    iteration would feel."""
+    xh, X, V = stage.xh, stage.X, stage.V
     held_idx, held_v = held.idx, held.v
-    free, mass, drag = nodes
     dim, n = X.shape
     for d in range(dim):
         for i in range(n):
@@ -171,7 +169,19 @@ def stage_residual(stage, rhs, beta, t_stage, held, nodes, params, body, groups)
             V[d, held_idx[j]] = held_v[d, j]
     if WITH_BODIES:
         place_stage(body, X, V, beta, params.bodies, groups.arm)
-    fluid, internal, seabed = accelerations(X, V, acc, params, t_stage)
+
+
+@jit.kernel
+def stage_residual(stage, rhs, beta, t_stage, nodes, params, body, groups):
+    """From the accelerations ``stage.acc`` at the stage's X and V (:func:`stage_velocities`), write minus the
+    residual of m (V - vh) = beta (a(X, V) m - b V) (plus A_i (V - vh) with added mass), times beta, into ``rhs``
+    (a body's: its own, into its group's, see :mod:`ropesim.integrate.sdirk_bodies`). Returns its squared norm.
+
+    The accelerations are the caller's to take (:func:`solve_stage`): called from here, the term list would be
+    linked into this function's own compiled library, and optimised and emitted there once more."""
+    xh, vh, X, acc = stage.xh, stage.vh, stage.X, stage.acc
+    free, mass, drag = nodes
+    dim, n = X.shape
     for i in range(n):
         for d in range(dim):
             u = i * dim + d
@@ -197,7 +207,7 @@ def stage_residual(stage, rhs, beta, t_stage, held, nodes, params, body, groups)
         norm += stage_rows(body, X, acc, beta, beta, t_stage, params, groups, rhs)
     for u in range(rhs.shape[0]):
         norm += rhs[u] * rhs[u]
-    return norm, fluid, internal, seabed
+    return norm
 
 
 @jit.kernel
@@ -249,8 +259,9 @@ def solve_stage(stage, newton, beta, t_stage, t_piece, held, nodes, params):
     stride = 0.0             # the last update's largest component [m]
     halvings = 0
     for it in range(NEWTON_MAX_ITER):
-        norm, fluid, internal, seabed = stage_residual(stage, rhs, beta, t_stage, held, nodes, params, newton.body,
-                                                       newton.groups)
+        stage_velocities(stage, beta, held, params, newton.body, newton.groups)
+        fluid, internal, seabed = accelerations(X, V, stage.acc, params, t_stage)
+        norm = stage_residual(stage, rhs, beta, t_stage, nodes, params, newton.body, newton.groups)
         if norm > last and stride > BACKTRACK_ABOVE * newton.tol and halvings < MAX_HALVINGS:
             # the full step made the residual worse (a contact switching on, friction reversing): go back half
             # of it and look again; a smooth problem never gets here, so its iterates are Newton's own

@@ -163,7 +163,8 @@ def _solve(model, x: np.ndarray | None, tol: float, max_iterations: int, pose: n
     jac = Jacobian(np.zeros(((w + 1) * dim, nt)), np.zeros((m, m)), np.zeros((dim, dim)), w)
     wood = woodbury(nt, m)
     nodes = (free, mass, np.where(model.held, 0.0, model.drag))
-    dragged = {WITH_FLUID_DRAG.name, WITH_VISCOUS_DRAG.name} & model.switches
+    # the drag's tangent stiffness: zero at rest without a flow (u = v - U = 0), neither compiled nor applied then
+    dragged = bool({WITH_FLUID_DRAG.name, WITH_VISCOUS_DRAG.name} & model.switches) and WITH_FLOW.name in model.switches
     if not differenced or (cyclic and n < 2 * w + 1):
         differenced, jacobian, tangent_stiffness = None, model.kernel(newton_matrix), \
             model.kernel(add_fluid_tangent_stiffness)
@@ -251,7 +252,7 @@ def _solve(model, x: np.ndarray | None, tol: float, max_iterations: int, pose: n
         extra = None           # the matrix's part the banded solve leaves out: by GMRES
         if differenced is not None:
             rest = differenced.fill(x, jac, tau)   # M + tau b + tau^2 K + tau C, so the step is tau^2 F
-            if dragged and WITH_FLOW.name in model.switches:   # the drag's tangent stiffness in a flow
+            if dragged:   # the drag's tangent stiffness in a flow
                 extra = lambda z, rest=rest: folded(differenced.apply(rest, z))
         else:
             jacobian(x, v, jac, tau, nodes, p, t)
