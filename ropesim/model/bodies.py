@@ -66,6 +66,7 @@ from .body_layout import (ADDED, ADDED_N, ADDED_ROT, ADDED_T, ARM, BODY_COLUMNS,
                           CONSTANT, DAMPER, DRAG, DRAG_ROT, INERTIA, INVERSE, LIFT, LINK_COLUMNS, MASS, NODE_MASS,
                           REST, SCRATCH, SPRING, VARIES, Bodies)
 from .body_sea import WITH_BODY_SEA, sea_loads
+from .forces.added_mass import WITH_ADDED_MASS
 from .forces.fluid import WITH_FLOW, flow_at, node_tangent
 from ..scene.schema import STILL_KINDS
 from .rotation import cross, matrix_of, quaternion_from_angles, rotate, rotate_back, turn
@@ -639,8 +640,8 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
             n0, n1, n2 = cross(wb0, wb1, wb2, e0, e1, e2)   # w x (w x s)
             mn = mi + a_n
             g0, g1, g2 = g0 - mn * n0, g1 - mn * n1, g2 - mn * n2
-            if a_t != a_n:   # (a_t - a_n) q q^T = c d d^T with d the chord along the line, c = (a_t - a_n) / |d|^2
-                if moved:
+            if WITH_ADDED_MASS and a_t != a_n:   # (a_t - a_n) q q^T = c d d^T, d the chord along the line,
+                if moved:                          # c = (a_t - a_n) / |d|^2
                     lo, hi = around[0, i], around[1, i]
                     d0, d1, d2 = rotate_back(r, x[0, hi] - x[0, lo], x[1, hi] - x[1, lo],
                                              x[2, hi] - x[2, lo] if dim == 3 else 0.0)
@@ -653,26 +654,30 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
                 g0, g1, g2 = g0 - along * d0, g1 - along * d1, g2 - along * d2
             h0, h1, h2 = cross(s0, s1, s2, g0, g1, g2)
             f0, f1, f2, m0, m1, m2 = f0 + g0, f1 + g1, f2 + g2, m0 + h0, m1 + h1, m2 + h2
-        if moved and varies:
-            if n == 6:   # 3-D: written out in scalars, the same numbers (_factor6)
-                _factor6(work, bodies.matrices[b, CONSTANT], links, k_first, k_end)
-            else:
-                _varying_mass(work, bodies.matrices[b, CONSTANT], n, links, k_first, k_end)
-                _ldl_factor(work, n)
-        if varies and n == 6:
-            ab0, ab1, ab2, alb0, alb1, alb2 = _solve6(work, f0, f1, f2, m0, m1, m2)
-        else:
+        solved = False   # a body's mass matrix varies only with its attachments' added mass (compiled only then)
+        if WITH_ADDED_MASS:
+            if moved and varies:
+                if n == 6:   # 3-D: written out in scalars, the same numbers (_factor6)
+                    _factor6(work, bodies.matrices[b, CONSTANT], links, k_first, k_end)
+                else:
+                    _varying_mass(work, bodies.matrices[b, CONSTANT], n, links, k_first, k_end)
+                    _ldl_factor(work, n)
+            if varies and n == 6:
+                ab0, ab1, ab2, alb0, alb1, alb2 = _solve6(work, f0, f1, f2, m0, m1, m2)
+                solved = True
+        if not solved:
             work[0, 6], work[1, 6] = f0, f1   # the kept rows' right-hand side: x, y and the turn about z in 2-D
             if n == 3:
                 work[2, 6] = m2
             else:
                 work[2, 6], work[3, 6], work[4, 6], work[5, 6] = f2, m0, m1, m2
-            if varies:
-                _ldl_solve(work, n, work)
-                at = 6
-            else:   # the constant matrix's inverse times the right-hand side, into the unused first column
+            at = 0
+            if WITH_ADDED_MASS:
+                if varies:
+                    _ldl_solve(work, n, work)
+                    at = 6
+            if at == 0:   # the constant matrix's inverse times the right-hand side, into the unused first column
                 _times_inverse(bodies.matrices[b, INVERSE], n, work)
-                at = 0
             if n == 3:   # 2-D: x, y and the turn about z
                 ab0, ab1, ab2, alb0, alb1, alb2 = work[0, at], work[1, at], 0.0, 0.0, 0.0, work[2, at]
             else:
@@ -698,7 +703,8 @@ def move_bodies(x, v, acc, inv_mass, around, gravity, flow, bodies, pose, twist,
             if dim == 3:
                 acc[2, i] = k2
             a_n, a_t = link[ADDED_N], link[ADDED_T]
-            if a_n != 0.0 or a_t != 0.0:   # the fluid's inertial force -A_i a_i on the node, at its velocity
+            if WITH_ADDED_MASS and (a_n != 0.0 or a_t != 0.0):   # the fluid's inertial force -A_i a_i on the
+                # node, at its velocity
                 h0, h1, h2 = a_n * kb0, a_n * kb1, a_n * kb2   # in body axes, with the chord kept above
                 if a_t != a_n:
                     d0, d1, d2 = link[CHORD], link[CHORD + 1], link[CHORD + 2]
