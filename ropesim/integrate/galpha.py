@@ -23,19 +23,20 @@ banded and a system's points and free rigid bodies are joined by a Schur complem
 as in SDIRK2; a body's six unknowns (its reference point and a rotation vector on its orientation) are stepped as
 the nodes are (:mod:`ropesim.integrate.galpha_bodies`).
 
-Modified Newton: the matrix is factored when the step size changes by more than REUSE_WITHIN or when Newton
-converges slowly (an update not smaller than RATE_REFACTOR times the one before it), and is otherwise reused, across
-steps too. A free body's updates are watched on their own (its block goes stale as it turns): with a matrix from an
-earlier step, one above BODY_RATE_REFACTOR times the body's last is not convergence, and factors the matrix again.
-Without that, the stale block's few 1e-15 m of error a step, divided by beta_v into the body's velocities, added up
-over many small steps (the tumbling tripod at 78 us: its angular velocity 1.1e-6 rad/s off after 0.1 s, 6e-8 with
-it, near a fresh matrix every step). A full update that raises the residual (a contact switching on, a segment going
-slack) is halved (a backtracking line search). The non-smooth terms are not regularised beyond what the force terms
-already do (the seabed's onset and the friction have their own smoothing lengths, see the seabed's docs), with two
-exceptions (:mod:`ropesim.model.forces.seabed`): MoorDyn's two-way seabed damping (``damping_both_ways``), a force
-that jumps by c A |v . n| at first contact, grows in over the seabed's delta_d for galpha; and ropesim's own
-one-way damping, which switches on and off at v . n = 0, does so smoothly over v_reg; compressive geometric
-stiffness is left out of the matrix as in SDIRK2.
+Modified Newton: the matrix is factored when the step size changes by more than REUSE_WITHIN or when Newton converges
+slowly (an update not smaller than RATE_REFACTOR times the one before it), and is otherwise reused, across steps too.
+A free body's updates are watched on their own (its block goes stale as it turns): with a matrix from an earlier
+step, one above BODY_RATE_REFACTOR times the body's last is not convergence, and factors the matrix again. Without
+that, the stale block's few 1e-15 m of error a step, divided by beta_v into the body's velocities, added up over many
+small steps (the tumbling tripod at 78 us: its angular velocity 1.1e-6 rad/s off after 0.1 s, 6e-8 with it, near a
+fresh matrix every step). With fixed steps Newton stops once its remaining error is below NEWTON_SHARE of the step's
+own truncation estimate (at most NEWTON_LOOSEST; :func:`solve_step`). A full update that raises the residual (a
+contact switching on, a segment going slack) is halved (a backtracking line search). The non-smooth terms are not
+regularised beyond what the force terms already do (the seabed's onset and the friction have their own smoothing
+lengths, see the seabed's docs), with two exceptions (:mod:`ropesim.model.forces.seabed`): MoorDyn's two-way seabed
+damping (``damping_both_ways``), a force that jumps by c A |v . n| at first contact, grows in over the seabed's
+delta_d for galpha; and ropesim's own one-way damping, which switches on and off at v . n = 0, does so smoothly over
+v_reg; compressive geometric stiffness is left out of the matrix as in SDIRK2.
 
 For a stiff line read by its tension (a mooring), rho_inf = 0 is the setting: af = 0, so the force balance is
 solved at the step's end itself and the tension at a step end (EA times its strain) is the solved one; with
@@ -437,9 +438,8 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats, an):
     failed, naming the node that moved most in the last update.
 
     It stops when the last update, or the remaining error estimated from it and the rate of convergence, is below
-    ``newton.tol``, or with fixed steps below
-    NEWTON_SHARE of the step's own truncation estimate at the iterate (:func:`local_error`), at most
-    ``newton.loosest``."""
+    ``newton.tol``, or with fixed steps below NEWTON_SHARE of the step's own truncation estimate at the iterate
+    (:func:`local_error`), at most ``newton.loosest``."""
     am, af, gam, beta = co[0], co[1], co[2], co[3]
     c2 = (1.0 - af) * beta * h * h / (1.0 - am)
     beta_v = beta * h / gam
