@@ -99,6 +99,11 @@ NEWTON_LOOSEST = 1e-4     # ... but never looser than this strain of the shortes
 # touchdown at 0.1 s after steps stopped centimetres short of their force balance. Not at rho_inf = 1: a solve within
 # a tenth of each step's position error is not within a tenth of the energy's, which the trapezoidal rule keeps
 # bounded (the vacuum pendulum's energy error at 2 ms grew by 15 %, its fitted order 2.18 instead of 2.00)
+CARRY_GROWTH = 2.0        # with the share, a step's first update is judged by the last measured rate of a first
+# update (the carried matrix's contraction, kept in control[FIRST_RATE]); each step that stops on it doubles it, so
+# one in a few steps measures it again (WD0050 at 6.25 ms: 1.74 iterations a step instead of 2.01, the error the
+# same to 3 digits; at 1.25 instead of 2: 1.61, but 10 % more error at 25 ms; the rate at a step's end, Radau5's
+# choice, was 30 times too optimistic: an error of 2.9 % at 0.1 s)
 NEWTON_MAX_ITER = 60     # residual evaluations per step, halvings included
 RATE_REFACTOR = 0.1      # an update larger than this times the one before it: factor the matrix again (two
 # iterations' cost; at 0.25 a stale matrix crawled on at rates of 0.15 to 0.23 for ten iterations at WD0050's touchdown)
@@ -109,8 +114,8 @@ MAX_HALVINGS = 8
 BODY_RATE_REFACTOR = 1e-3   # a free body's update larger than this times its last: factor again (see solve_step)
 
 # the control array: the step the matrix was factored for (0: none), whether a_n holds the start's acceleration,
-# the last step (0: none)
-FACTORED_H, STARTED, LAST_H = 0, 1, 2
+# the last step (0: none), the rate of the last measured first update (0: none)
+FACTORED_H, STARTED, LAST_H, FIRST_RATE = 0, 1, 2, 3
 # the statistics: Newton iterations, factorisations, steps taken
 ITERATIONS, FACTORISATIONS, STEPS = 0, 1, 2
 
@@ -214,7 +219,7 @@ class GeneralizedAlphaFamily(Integrator):
         self.nodes = Nodes(np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag))
         self.acc_n = np.zeros((dim, n))
         self.stats = np.zeros(3, dtype=np.int64)
-        self.control = np.zeros(3)
+        self.control = np.zeros(4)
         self.powers = np.zeros(6)
         # the factored matrix is state: a resumed run reuses it exactly as the uninterrupted one did
         self.matrix = {"band": jac.band, "corner": jac.corner,
@@ -441,8 +446,8 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats, an):
     fast). Returns (iterations, node, fluid, internal-damping and seabed power [W]); iterations < 0 when it
     failed, naming the node that moved most in the last update.
 
-    It stops when the last update, or the remaining error estimated from it and the rate of convergence, is below
-    ``newton.tol``, or with fixed steps below NEWTON_SHARE of the step's own truncation estimate at the iterate
+    It stops when the last update, or the remaining error estimated from it and the rate of convergence (for a first
+    update with the share: the last measured first update's, see CARRY_GROWTH), is below ``newton.tol``, or with fixed steps below NEWTON_SHARE of the step's own truncation estimate at the iterate
     (:func:`local_error`), at most ``newton.loosest``."""
     am, af, gam, beta = co[0], co[1], co[2], co[3]
     c2 = (1.0 - af) * beta * h * h / (1.0 - am)
@@ -496,12 +501,21 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats, an):
             turning = moved
             stride = max(stride, moved)
         stats[ITERATIONS] += 1
-        rate = stride / previous if previous > 0.0 else 1.0
+        if previous > 0.0:
+            rate = stride / previous
+            if it == 1 and newton.loosest > 0.0:
+                control[FIRST_RATE] = rate
+        elif newton.loosest > 0.0 and control[FIRST_RATE] > 0.0:
+            rate = control[FIRST_RATE]
+        else:
+            rate = 1.0
         left = stride * rate / (1.0 - rate) if rate < 1.0 else np.inf
         tol = newton.tol
         if newton.loosest > 0.0 and min(stride, left) > tol:
             tol = max(tol, min(newton.loosest, NEWTON_SHARE * local_error(work, an, co, h, nodes.free)))
         if not slow_body and (stride <= tol or left <= tol):
+            if it == 0 and newton.loosest > 0.0:
+                control[FIRST_RATE] = min(1.0, CARRY_GROWTH * control[FIRST_RATE])
             for d in range(X.shape[0]):
                 for i in range(X.shape[1]):
                     V[d, i] = work.Vk[d, i] + (X[d, i] - work.Xk[d, i]) / beta_v
