@@ -103,7 +103,9 @@ CARRY_GROWTH = 2.0        # with the share, a step's first update is judged by t
 # update (the carried matrix's contraction, kept in control[FIRST_RATE]); each step that stops on it doubles it, so
 # one in a few steps measures it again (WD0050 at 6.25 ms: 1.74 iterations a step instead of 2.01, the error the
 # same to 3 digits; at 1.25 instead of 2: 1.61, but 10 % more error at 25 ms; the rate at a step's end, Radau5's
-# choice, was 30 times too optimistic: an error of 2.9 % at 0.1 s)
+# choice, was 30 times too optimistic: an error of 2.9 % at 0.1 s). Not with free bodies, whose stale blocks are
+# watched from the second update on (BODY_RATE_REFACTOR): stopping at the first, the torque-free body's energy and
+# the tumbling body's velocities no longer converged at second order (tests/test_galpha_bodies.py)
 NEWTON_MAX_ITER = 60     # residual evaluations per step, halvings included
 RATE_REFACTOR = 0.1      # an update larger than this times the one before it: factor the matrix again (two
 # iterations' cost; at 0.25 a stale matrix crawled on at rates of 0.15 to 0.23 for ten iterations at WD0050's touchdown)
@@ -505,7 +507,7 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats, an):
             rate = stride / previous
             if it == 1 and newton.loosest > 0.0:
                 control[FIRST_RATE] = rate
-        elif newton.loosest > 0.0 and control[FIRST_RATE] > 0.0:
+        elif not WITH_BODIES and newton.loosest > 0.0 and control[FIRST_RATE] > 0.0:
             rate = control[FIRST_RATE]
         else:
             rate = 1.0
