@@ -428,7 +428,7 @@ def factor_matrix(work, newton, c2, beta_v, t_f, nodes, params):
 def local_error(work, an, co, h, free):
     """The step's local truncation estimate at the iterate X, largest over the free nodes [m]: h^2 |beta - 1/6 +
     (am - af) / 2| |a_(n+1) - a_n| (unfiltered, :mod:`ropesim.integrate.galpha_adaptive`)."""
-    am, af, gam, beta = co[0], co[1], co[2], co[3]
+    am, af, beta = co[0], co[1], co[3]
     scale = 1.0 / ((1.0 - af) * beta * h * h)
     dim, n = work.X.shape
     worst = 0.0
