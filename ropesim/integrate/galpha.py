@@ -188,8 +188,7 @@ Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol", "step", "g
 """As SDIRK2's (:class:`ropesim.integrate.sdirk.Newton`), the free bodies' arrays those of
 :class:`ropesim.integrate.galpha_bodies.BodyAlpha`; with fixed steps ``loosest`` [m] is the most the stopping test
 may allow for a step's share of its truncation estimate (0: the adaptive steps and rho_inf = 1, Newton stops at
-``tol``);
-``backtrack`` [m]: an update above it that raised the residual is halved."""
+``tol``); ``backtrack`` [m]: an update above it that raised the residual is halved."""
 
 Nodes = namedtuple("Nodes", ["free", "mass", "drag"])
 """Per node: free (not held), mass [kg], linear drag b [kg/s] (0 at held nodes)."""
@@ -449,8 +448,9 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats, an):
     failed, naming the node that moved most in the last update.
 
     It stops when the last update, or the remaining error estimated from it and the rate of convergence (for a first
-    update with the share: the last measured first update's, see CARRY_GROWTH), is below ``newton.tol``, or with fixed steps below NEWTON_SHARE of the step's own truncation estimate at the iterate
-    (:func:`local_error`), at most ``newton.loosest``."""
+    update with the share: the last measured first update's, see CARRY_GROWTH), is below ``newton.tol``, or with
+    fixed steps below NEWTON_SHARE of the step's own truncation estimate at the iterate (:func:`local_error`), at
+    most ``newton.loosest``."""
     am, af, gam, beta = co[0], co[1], co[2], co[3]
     c2 = (1.0 - af) * beta * h * h / (1.0 - am)
     beta_v = beta * h / gam
