@@ -98,14 +98,15 @@ NEWTON_LOOSEST = 1e-4     # ... but never looser than this strain of the shortes
 # (a stiff mode's, at a touchdown, is many times its true error), and without a ceiling WD0050's Newton failed at a
 # touchdown at 0.1 s after steps stopped centimetres short of their force balance. Not at rho_inf = 1: a solve within
 # a tenth of each step's position error is not within a tenth of the energy's, which the trapezoidal rule keeps
-# bounded (the vacuum pendulum's energy error at 2 ms grew by 15 %, its fitted order 2.18 instead of 2.00)
+# bounded (the vacuum pendulum's energy error at 2 ms grew by 15 %, its fitted order 2.18 instead of 2.00). Nor
+# on a system of lines (points, free bodies): the clump weight's stiff wires at 1 ms took 10 % more error (fitted
+# order 2.08 against 2 +- 0.05), 25 % with the carried rate below, and the torque-free body's energy and the tumbling
+# body's velocities no longer converged at second order with it (tests/test_galpha*.py)
 CARRY_GROWTH = 2.0        # with the share, a step's first update is judged by the last measured rate of a first
 # update (the carried matrix's contraction, kept in control[FIRST_RATE]); each step that stops on it doubles it, so
 # one in a few steps measures it again (WD0050 at 6.25 ms: 1.74 iterations a step instead of 2.01, the error the
 # same to 3 digits; at 1.25 instead of 2: 1.61, but 10 % more error at 25 ms; the rate at a step's end, Radau5's
-# choice, was 30 times too optimistic: an error of 2.9 % at 0.1 s). Not with free bodies, whose stale blocks are
-# watched from the second update on (BODY_RATE_REFACTOR): stopping at the first, the torque-free body's energy and
-# the tumbling body's velocities no longer converged at second order (tests/test_galpha_bodies.py)
+# choice, was 30 times too optimistic: an error of 2.9 % at 0.1 s)
 NEWTON_MAX_ITER = 60     # residual evaluations per step, halvings included
 RATE_REFACTOR = 0.1      # an update larger than this times the one before it: factor the matrix again (two
 # iterations' cost; at 0.25 a stale matrix crawled on at rates of 0.15 to 0.23 for ten iterations at WD0050's touchdown)
@@ -187,8 +188,8 @@ Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol", "step", "g
                                "backtrack"])
 """As SDIRK2's (:class:`ropesim.integrate.sdirk.Newton`), the free bodies' arrays those of
 :class:`ropesim.integrate.galpha_bodies.BodyAlpha`; with fixed steps ``loosest`` [m] is the most the stopping test
-may allow for a step's share of its truncation estimate (0: the adaptive steps and rho_inf = 1, Newton stops at
-``tol``); ``backtrack`` [m]: an update above it that raised the residual is halved."""
+may allow for a step's share of its truncation estimate (0: the adaptive steps, rho_inf = 1 and systems of lines,
+Newton stops at ``tol``); ``backtrack`` [m]: an update above it that raised the residual is halved."""
 
 Nodes = namedtuple("Nodes", ["free", "mass", "drag"])
 """Per node: free (not held), mass [kg], linear drag b [kg/s] (0 at held nodes)."""
@@ -214,7 +215,7 @@ class GeneralizedAlphaFamily(Integrator):
         groups = model_groups(model, w) if grouped else None   # a rope's: none
         body = body_alpha(model, groups) if WITH_BODIES.name in model.switches else None
         self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, tol, np.zeros(nt), groups, body,
-                             NEWTON_LOOSEST * shortest if self.rho_inf < 1.0 else 0.0,
+                             NEWTON_LOOSEST * shortest if self.rho_inf < 1.0 and groups is None else 0.0,
                              BACKTRACK_ABOVE * min(tol, NEWTON_TOL * shortest))
         self.work = Work(*(np.zeros((dim, n)) for _ in Work._fields))
         self.nodes = Nodes(np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag))
@@ -507,7 +508,7 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats, an):
             rate = stride / previous
             if it == 1 and newton.loosest > 0.0:
                 control[FIRST_RATE] = rate
-        elif not WITH_BODIES and newton.loosest > 0.0 and control[FIRST_RATE] > 0.0:
+        elif newton.loosest > 0.0 and control[FIRST_RATE] > 0.0:
             rate = control[FIRST_RATE]
         else:
             rate = 1.0
