@@ -4,12 +4,19 @@ MoorDyn's RK2 step.
     python scripts/bench_galpha_step.py [--tolerance 1] [--dt 0.1] [--window 30] [--calls 2000] [--rho-inf R]
         [--own-seabed]
     python scripts/bench_galpha_step.py --seabed-effect 0.0025   # the two-way damping's regularisation
+    python scripts/bench_galpha_step.py --cpu 0.1 0.00625 --window 120   # CPU time against MoorDyn's RK2
 
 Times each compiled part of a step on the case's state at rest (the force evaluation with its residual, the
 matrix's assembly and factorisation, a solve with the factored matrix), then runs the case with adaptive steps
 at ``--tolerance`` and with fixed steps of ``--dt``, and breaks the run's time into those parts from its counts
 (steps, rejections, Newton iterations, factorisations). MoorDyn's RK2 step is two force evaluations of its own
 (its ns per node and evaluation from bench_moorings' term costs).
+
+``--cpu DT ...`` instead times whole runs in CPU time (``time.process_time``, less disturbed by other processes
+than wall time): ``ropesim.simulate`` with galpha at each fixed step DT (frames every 0.1 s, their derived arrays
+and the summary included) against MoorDyn's RK2 at ``--moordyn-dt`` (its largest stable step on WD0050, from
+bench_moorings' ladder) with a ``Step`` every 0.1 s, the fastest of ``--rounds`` interleaved rounds, and a galpha
+step's cost in MoorDyn force evaluations (two per RK2 step).
 """
 
 from __future__ import annotations
@@ -48,7 +55,13 @@ def main() -> int:
     parser.add_argument("--seabed-effect", type=float, metavar="DT",
                         help="instead: the fairlead tension of galpha at fixed steps DT with MoorDyn's two-way "
                              "damping grown in (galpha's) and as MoorDyn has it, against each other and rk4")
+    parser.add_argument("--cpu", type=float, nargs="+", metavar="DT",
+                        help="instead: CPU time of galpha at these fixed steps against MoorDyn's RK2")
+    parser.add_argument("--moordyn-dt", type=float, default=0.1 / 45, help="MoorDyn RK2's step for --cpu [s]")
+    parser.add_argument("--rounds", type=int, default=3, help="interleaved rounds for --cpu (the fastest counts)")
     args = parser.parse_args()
+    if args.cpu:
+        return cpu_times(args.cpu, args.moordyn_dt, args.window, args.rounds, args.rho_inf)
     if args.seabed_effect:
         return seabed_effect(args.seabed_effect, args.window, args.rho_inf)
     SEABED["both_ways"] = not args.own_seabed
@@ -107,6 +120,54 @@ def main() -> int:
               f"solves {its * parts['solve (factored)']:.3f} s, factorisations {fac * parts['assembly + factorisation']:.3f} s")
         if report["steps_taken"]:
             print(f"  mean step {args.window / report['steps_taken'] * 1e3:.2f} ms")
+    return 0
+
+
+def cpu_times(steps: list[float], moordyn_dt: float, window: float, rounds: int, rho_inf: float) -> int:
+    """galpha at each of ``steps`` against MoorDyn's RK2 at ``moordyn_dt`` over ``window`` s: CPU seconds, the
+    fastest of ``rounds`` interleaved rounds, and one galpha step's cost in MoorDyn force evaluations."""
+    import os
+
+    import tomli_w
+
+    import ropesim
+    from bench_moorings import DT_OUT, SURGE, moordyn_run, problem
+    from references.moordyn_own_cases import chain_scene_dict
+
+    case, start = problem()
+    scenes = {}
+    for dt in steps:
+        scene = chain_scene_dict(case, start, method="galpha", dt=dt, t_end=window, interval=DT_OUT, dimension=3,
+                                 both_ways=True, surge=SURGE)
+        scene["integrator"]["rho_inf"] = rho_inf
+        scenes[dt] = ropesim.scene_from_toml(tomli_w.dumps(scene))
+        ropesim.simulate(scenes[dt])   # compiled before the clock starts
+    moordyn_run(case, start, "RK2", moordyn_dt, 1.0, DT_OUT)
+    best = {}
+    for _ in range(rounds):
+        tick = time.process_time()
+        out = moordyn_run(case, start, "RK2", moordyn_dt, window, DT_OUT)
+        best["moordyn"] = min(best.get("moordyn", np.inf), time.process_time() - tick)
+        if not out["ok"]:
+            print(f"MoorDyn RK2 at {moordyn_dt:g} s: {out['status']}")
+            return 1
+        for dt, scene in scenes.items():
+            tick = time.process_time()
+            traj = ropesim.simulate(scene)
+            best[dt] = min(best.get(dt, np.inf), time.process_time() - tick)
+            if traj.summary["status"] != "completed":
+                print(f"galpha at {dt:g} s: {traj.summary['status']}")
+                return 1
+    evaluation = best["moordyn"] / (2 * window / moordyn_dt)
+    print(f"WD0050, {window:g} s, CPU seconds (fastest of {rounds} rounds, load {os.getloadavg()[0]:.1f}):")
+    print(f"  MoorDyn RK2 at {moordyn_dt * 1e3:.3g} ms: {best['moordyn']:.3f} s, {evaluation * 1e6:.2f} us per force "
+          f"evaluation")
+    for dt in steps:
+        step = best[dt] / (window / dt)
+        spent = 2 * dt / moordyn_dt   # MoorDyn's evaluations in the same simulated time
+        print(f"  galpha at {dt * 1e3:.3g} ms: {best[dt]:.3f} s, {step * 1e6:.1f} us a step = "
+              f"{step / evaluation:.1f} MoorDyn evaluations against its {spent:.1f}: "
+              f"{best['moordyn'] / best[dt]:.2f}x")
     return 0
 
 

@@ -23,19 +23,20 @@ banded and a system's points and free rigid bodies are joined by a Schur complem
 as in SDIRK2; a body's six unknowns (its reference point and a rotation vector on its orientation) are stepped as
 the nodes are (:mod:`ropesim.integrate.galpha_bodies`).
 
-Modified Newton: the matrix is factored when the step size changes by more than REUSE_WITHIN or when Newton
-converges slowly (an update not smaller than RATE_REFACTOR times the one before it), and is otherwise reused, across
-steps too. A free body's updates are watched on their own (its block goes stale as it turns): with a matrix from an
-earlier step, one above BODY_RATE_REFACTOR times the body's last is not convergence, and factors the matrix again.
-Without that, the stale block's few 1e-15 m of error a step, divided by beta_v into the body's velocities, added up
-over many small steps (the tumbling tripod at 78 us: its angular velocity 1.1e-6 rad/s off after 0.1 s, 6e-8 with
-it, near a fresh matrix every step). A full update that raises the residual (a contact switching on, a segment going
-slack) is halved (a backtracking line search). The non-smooth terms are not regularised beyond what the force terms
-already do (the seabed's onset and the friction have their own smoothing lengths, see the seabed's docs), with two
-exceptions (:mod:`ropesim.model.forces.seabed`): MoorDyn's two-way seabed damping (``damping_both_ways``), a force
-that jumps by c A |v . n| at first contact, grows in over the seabed's delta_d for galpha; and ropesim's own
-one-way damping, which switches on and off at v . n = 0, does so smoothly over v_reg; compressive geometric
-stiffness is left out of the matrix as in SDIRK2.
+Modified Newton: the matrix is factored when the step size changes by more than REUSE_WITHIN or when Newton converges
+slowly (an update not smaller than RATE_REFACTOR times the one before it), and is otherwise reused, across steps too.
+A free body's updates are watched on their own (its block goes stale as it turns): with a matrix from an earlier
+step, one above BODY_RATE_REFACTOR times the body's last is not convergence, and factors the matrix again. Without
+that, the stale block's few 1e-15 m of error a step, divided by beta_v into the body's velocities, added up over many
+small steps (the tumbling tripod at 78 us: its angular velocity 1.1e-6 rad/s off after 0.1 s, 6e-8 with it, near a
+fresh matrix every step). With fixed steps Newton stops once its remaining error is below NEWTON_SHARE of the step's
+own truncation estimate (at most NEWTON_LOOSEST; :func:`solve_step`). A full update that raises the residual (a
+contact switching on, a segment going slack) is halved (a backtracking line search). The non-smooth terms are not
+regularised beyond what the force terms already do (the seabed's onset and the friction have their own smoothing
+lengths, see the seabed's docs), with two exceptions (:mod:`ropesim.model.forces.seabed`): MoorDyn's two-way seabed
+damping (``damping_both_ways``), a force that jumps by c A |v . n| at first contact, grows in over the seabed's
+delta_d for galpha; and ropesim's own one-way damping, which switches on and off at v . n = 0, does so smoothly over
+v_reg; compressive geometric stiffness is left out of the matrix as in SDIRK2.
 
 For a stiff line read by its tension (a mooring), rho_inf = 0 is the setting: af = 0, so the force balance is
 solved at the step's end itself and the tension at a step end (EA times its strain) is the solved one; with
@@ -90,17 +91,35 @@ NEWTON_TOL_STEP = 0.01   # [s] below this fixed step Newton's tolerance shrinks 
 NEWTON_TOL_FLOOR = 1e-11  # SDIRK2's
 NEWTON_STRAIN = 1e-6      # with adaptive steps Newton stops at a hundredth of the tolerance, but at most this strain
 # of the shortest segment (an unconverged solve is an error in every segment's force balance, EA times it)
+NEWTON_SHARE = 0.1       # with fixed steps Newton stops once its remaining error is below this share of the step's own
+# truncation estimate (Hairer & Wanner IV.8 stop at 0.01 to 0.1 of the error tolerance): the solve then adds at most a
+# tenth to the step's error. On WD0050 at 0.1 s, 4.0 instead of 6.25 iterations a step, the fairlead tension's error
+# 0.4672 % of its range instead of 0.4662 %
+NEWTON_LOOSEST = 1e-4     # ... but never looser than this strain of the shortest segment: the estimate is unfiltered
+# (a stiff mode's, at a touchdown, is many times its true error), and without a ceiling WD0050's Newton failed at a
+# touchdown at 0.1 s after steps stopped centimetres short of their force balance. Not at rho_inf = 1: a solve within
+# a tenth of each step's position error is not within a tenth of the energy's, which the trapezoidal rule keeps
+# bounded (the vacuum pendulum's energy error at 2 ms grew by 15 %, its fitted order 2.18 instead of 2.00). Nor
+# on a system of lines (points, free bodies): the clump weight's stiff wires at 1 ms took 10 % more error (fitted
+# order 2.08 against 2 +- 0.05), 25 % with the carried rate below, and the torque-free body's energy and the tumbling
+# body's velocities no longer converged at second order with it (tests/test_galpha*.py)
+CARRY_GROWTH = 2.0        # with the share, a step's first update is judged by the last measured rate of a first
+# update (the carried matrix's contraction, kept in control[FIRST_RATE]); each step that stops on it doubles it, so
+# one in a few steps measures it again (WD0050 at 6.25 ms: 1.74 iterations a step instead of 2.01, the error the
+# same to 3 digits; at 1.25 instead of 2: 1.61, but 10 % more error at 25 ms; the rate at a step's end, Radau5's
+# choice, was 30 times too optimistic: an error of 2.9 % at 0.1 s)
 NEWTON_MAX_ITER = 60     # residual evaluations per step, halvings included
 RATE_REFACTOR = 0.1      # an update larger than this times the one before it: factor the matrix again (two
 # iterations' cost; at 0.25 a stale matrix crawled on at rates of 0.15 to 0.23 for ten iterations at WD0050's touchdown)
 REUSE_WITHIN = 0.25      # a matrix factored for a step within this fraction of the step is reused
-BACKTRACK_ABOVE = 1e3    # halve an update that raised the residual, unless it was within this many tolerances
+BACKTRACK_ABOVE = 1e3    # halve an update that raised the residual, unless it was within this many times NEWTON_TOL
+# (of the shortest segment, at most the step's tolerance times it: a looser stopping test keeps the line search)
 MAX_HALVINGS = 8
 BODY_RATE_REFACTOR = 1e-3   # a free body's update larger than this times its last: factor again (see solve_step)
 
 # the control array: the step the matrix was factored for (0: none), whether a_n holds the start's acceleration,
-# the last step (0: none)
-FACTORED_H, STARTED, LAST_H = 0, 1, 2
+# the last step (0: none), the rate of the last measured first update (0: none)
+FACTORED_H, STARTED, LAST_H, FIRST_RATE = 0, 1, 2, 3
 # the statistics: Newton iterations, factorisations, steps taken
 ITERATIONS, FACTORISATIONS, STEPS = 0, 1, 2
 
@@ -166,9 +185,12 @@ Work = namedtuple("Work", ["Xk", "Xa", "Vk", "X", "V", "acc", "acc_box", "tmp"])
 """The step's known parts (Xk, Xa, Vk), its unknowns at the force point (X, V), accelerations there and scratch,
 all (D, N)."""
 
-Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol", "step", "groups", "body"])
+Newton = namedtuple("Newton", ["jac", "wood", "rhs", "cyclic", "tol", "step", "groups", "body", "loosest",
+                               "backtrack"])
 """As SDIRK2's (:class:`ropesim.integrate.sdirk.Newton`), the free bodies' arrays those of
-:class:`ropesim.integrate.galpha_bodies.BodyAlpha`."""
+:class:`ropesim.integrate.galpha_bodies.BodyAlpha`; with fixed steps ``loosest`` [m] is the most the stopping test
+may allow for a step's share of its truncation estimate (0: the adaptive steps, rho_inf = 1 and systems of lines,
+Newton stops at ``tol``); ``backtrack`` [m]: an update above it that raised the residual is halved."""
 
 Nodes = namedtuple("Nodes", ["free", "mass", "drag"])
 """Per node: free (not held), mass [kg], linear drag b [kg/s] (0 at held nodes)."""
@@ -193,12 +215,14 @@ class GeneralizedAlphaFamily(Integrator):
         grouped = {WITH_JUNCTIONS.name, WITH_BODIES.name} & model.switches
         groups = model_groups(model, w) if grouped else None   # a rope's: none
         body = body_alpha(model, groups) if WITH_BODIES.name in model.switches else None
-        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, tol, np.zeros(nt), groups, body)
+        self.newton = Newton(jac, woodbury(nt, m), np.zeros(nt), cyclic, tol, np.zeros(nt), groups, body,
+                             NEWTON_LOOSEST * shortest if self.rho_inf < 1.0 and groups is None else 0.0,
+                             BACKTRACK_ABOVE * min(tol, NEWTON_TOL * shortest))
         self.work = Work(*(np.zeros((dim, n)) for _ in Work._fields))
         self.nodes = Nodes(np.ascontiguousarray(~model.held), model.mass, np.where(model.held, 0.0, model.drag))
         self.acc_n = np.zeros((dim, n))
         self.stats = np.zeros(3, dtype=np.int64)
-        self.control = np.zeros(3)
+        self.control = np.zeros(4)
         self.powers = np.zeros(6)
         # the factored matrix is state: a resumed run reuses it exactly as the uninterrupted one did
         self.matrix = {"band": jac.band, "corner": jac.corner,
@@ -221,7 +245,8 @@ class GeneralizedAlphaFamily(Integrator):
             rtol = scene.integrator.relative_tolerance or 0.0
             self.adapt = new_adapt(self.x, self.v, self.ledger, grid.dt, tol, rtol)
             strain = NEWTON_STRAIN * shortest
-            self.newton = self.newton._replace(tol=max(NEWTON_TOL * shortest, min(NEWTON_FRACTION * tol, strain)))
+            self.newton = self.newton._replace(tol=max(NEWTON_TOL * shortest, min(NEWTON_FRACTION * tol, strain)),
+                                               loosest=0.0)
             for name in self.adapt._fields:
                 setattr(self, f"adapt_{name}", getattr(self.adapt, name))
             self.STATE += tuple(f"adapt_{name}" for name in self.adapt._fields)
@@ -400,11 +425,34 @@ def factor_matrix(work, newton, c2, beta_v, t_f, nodes, params):
     return factor(band, newton.jac.corner, newton.cyclic, band.shape[0] - 1, newton.wood)
 
 
+@jit.kernel
+def local_error(work, an, co, h, free):
+    """The step's local truncation estimate at the iterate X, largest over the free nodes [m]: h^2 |beta - 1/6 +
+    (am - af) / 2| |a_(n+1) - a_n| (unfiltered, :mod:`ropesim.integrate.galpha_adaptive`)."""
+    am, af, beta = co[0], co[1], co[3]
+    scale = 1.0 / ((1.0 - af) * beta * h * h)
+    dim, n = work.X.shape
+    worst = 0.0
+    for i in range(n):
+        if free[i]:
+            e2 = 0.0
+            for d in range(dim):
+                e = (work.X[d, i] - work.Xk[d, i]) * scale - an[d, i]
+                e2 += e * e
+            worst = max(worst, e2)
+    return h * h * abs(beta - 1.0 / 6.0 + 0.5 * (am - af)) * math.sqrt(worst)
+
+
 @jit.kernel(inline="always")
-def solve_step(work, newton, co, t, h, held, nodes, params, control, stats):
+def solve_step(work, newton, co, t, h, held, nodes, params, control, stats, an):
     """Newton's solve of one step for the force point X (modified Newton: the matrix reused while it converges
     fast). Returns (iterations, node, fluid, internal-damping and seabed power [W]); iterations < 0 when it
-    failed, naming the node that moved most in the last update."""
+    failed, naming the node that moved most in the last update.
+
+    It stops when the last update, or the remaining error estimated from it and the rate of convergence (for a first
+    update with the share: the last measured first update's, see CARRY_GROWTH), is below ``newton.tol``, or with
+    fixed steps below NEWTON_SHARE of the step's own truncation estimate at the iterate (:func:`local_error`), at
+    most ``newton.loosest``."""
     am, af, gam, beta = co[0], co[1], co[2], co[3]
     c2 = (1.0 - af) * beta * h * h / (1.0 - am)
     beta_v = beta * h / gam
@@ -424,7 +472,7 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats):
     for it in range(NEWTON_MAX_ITER):
         norm, fluid, internal, seabed = residual(work, rhs, c2, beta_v, t_f, held, nodes, params, newton.body,
                                                  newton.groups)
-        if norm > last and stride > BACKTRACK_ABOVE * newton.tol and halvings < MAX_HALVINGS:
+        if norm > last and stride > newton.backtrack and halvings < MAX_HALVINGS:
             halvings += 1   # the update made things worse: go back half of it (and factor afresh there)
             stride *= 0.5
             take_back_half(X, newton.step)
@@ -457,8 +505,21 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats):
             turning = moved
             stride = max(stride, moved)
         stats[ITERATIONS] += 1
-        rate = stride / previous if previous > 0.0 else 1.0
-        if not slow_body and (stride <= newton.tol or (rate < 1.0 and stride * rate / (1.0 - rate) <= newton.tol)):
+        if previous > 0.0:
+            rate = stride / previous
+            if it == 1 and newton.loosest > 0.0:
+                control[FIRST_RATE] = rate
+        elif newton.loosest > 0.0 and control[FIRST_RATE] > 0.0:
+            rate = control[FIRST_RATE]
+        else:
+            rate = 1.0
+        left = stride * rate / (1.0 - rate) if rate < 1.0 else np.inf
+        tol = newton.tol
+        if newton.loosest > 0.0 and min(stride, left) > tol:
+            tol = max(tol, min(newton.loosest, NEWTON_SHARE * local_error(work, an, co, h, nodes.free)))
+        if not slow_body and (stride <= tol or left <= tol):
+            if it == 0 and newton.loosest > 0.0:
+                control[FIRST_RATE] = min(1.0, CARRY_GROWTH * control[FIRST_RATE])
             for d in range(X.shape[0]):
                 for i in range(X.shape[1]):
                     V[d, i] = work.Vk[d, i] + (X[d, i] - work.Xk[d, i]) / beta_v
@@ -550,7 +611,7 @@ def advance_galpha(state, work, newton, co, held, nodes, params, limits, schedul
             step_start_bodies(newton.body, bodies.pose, bodies.twist, co, h)
         if WITH_WAVES:
             hold_waves(params, True)
-        its, node, fluid, internal, seabed = solve_step(work, newton, co, t, h, held, nodes, params, control, stats)
+        its, node, fluid, internal, seabed = solve_step(work, newton, co, t, h, held, nodes, params, control, stats, an)
         if WITH_WAVES:
             hold_waves(params, False)
         if its < 0:
@@ -624,7 +685,7 @@ def advance_adaptive(state, work, newton, co, held, nodes, params, limits, sched
                 if WITH_WAVES:
                     hold_waves(params, True)
                 its, node, fluid, internal, seabed = solve_step(work, newton, co, t, h, held, nodes, params,
-                                                                control, stats)
+                                                                control, stats, an)
                 if WITH_WAVES:
                     hold_waves(params, False)
                 if its < 0:
