@@ -61,8 +61,10 @@ def test_a_run_continued_from_a_frame_retraces_the_uninterrupted_run(tmp_path, m
     """From the frame at t = 0.5 s the second run's frames are the first run's from 0.5 s on: bit for bit (each
     method starts a step from x and v alone), the held node where the first run held it. Generalized-alpha
     also carries an acceleration, which a frame does not hold: the continued run starts from the true one
-    instead of the scheme's (they differ by O(h^2)), so it retraces the first within its own error (measured:
-    8e-7 m at dt = 1 ms; asserted 1e-5 m, with the held node exact)."""
+    instead of the scheme's (they differ by O(h^2)), and with fixed steps its Newton solve stops within a tenth
+    of each step's own error, where the two runs' iterates differ; so it retraces the first within a fifth of
+    the scheme's own error against PEFRL at half the step (measured: 2.2e-5 m, 0.094 of it, at dt = 1 ms), with
+    the held node exact."""
     first, second = _continued(tmp_path, method, 0.5)
     whole = ropesim.Trajectory.open(tmp_path / "runs" / "first")
     rest = ropesim.simulate(load_scene(second))
@@ -72,7 +74,10 @@ def test_a_run_continued_from_a_frame_retraces_the_uninterrupted_run(tmp_path, m
         np.testing.assert_array_equal(rest.x, whole.x[k:])
         np.testing.assert_array_equal(rest.v, whole.v[k:])
     else:
-        np.testing.assert_allclose(rest.x, whole.x[k:], rtol=0, atol=1e-5)
+        reference = _write(tmp_path, "reference.toml", CHAIN.format(method="pefrl", t_end=1.0).replace(
+            "dt = 0.001", "dt = 0.0005"))
+        own_error = np.abs(whole.x - ropesim.simulate(load_scene(reference)).x).max()
+        assert np.abs(rest.x - whole.x[k:]).max() <= 0.2 * own_error
         np.testing.assert_array_equal(rest.x[:, 0], whole.x[k:, 0])
 
 

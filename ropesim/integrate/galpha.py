@@ -92,8 +92,10 @@ NEWTON_TOL_FLOOR = 1e-11  # SDIRK2's
 NEWTON_STRAIN = 1e-6      # with adaptive steps Newton stops at a hundredth of the tolerance, but at most this strain
 # of the shortest segment (an unconverged solve is an error in every segment's force balance, EA times it)
 NEWTON_SHARE = 0.1       # with fixed steps Newton stops once its remaining error is below this share of the step's own
-# truncation estimate (Hairer & Wanner IV.8 stop at 0.01 to 0.1 of the error tolerance): the solve then adds at most a
-# tenth to the step's error. On WD0050 at 0.1 s, 4.0 instead of 6.25 iterations a step, the fairlead tension's error
+# truncation estimate (Hairer & Wanner IV.8 stop at 0.01 to 0.1 of the error tolerance), times h / NEWTON_TOL_STEP
+# below that step: a position error e left in X is an error e / beta_v in V, which grows as 1 / h against the
+# velocity's own local error (without the factor, a pinned chain at 1 ms left solve errors of 0.74 times the scheme's
+# own error; with it 0.056, tests/test_from_run.py): the solve then adds at most a tenth to the step's error. On WD0050 at 0.1 s, 4.0 instead of 6.25 iterations a step, the fairlead tension's error
 # 0.4672 % of its range instead of 0.4662 %
 NEWTON_LOOSEST = 1e-4     # ... but never looser than this strain of the shortest segment: the estimate is unfiltered
 # (a stiff mode's, at a touchdown, is many times its true error), and without a ceiling WD0050's Newton failed at a
@@ -451,8 +453,8 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats, an):
 
     It stops when the last update, or the remaining error estimated from it and the rate of convergence (for a first
     update with the share: the last measured first update's, see CARRY_GROWTH), is below ``newton.tol``, or with
-    fixed steps below NEWTON_SHARE of the step's own truncation estimate at the iterate (:func:`local_error`), at
-    most ``newton.loosest``."""
+    fixed steps below NEWTON_SHARE of the step's own truncation estimate at the iterate (:func:`local_error`; times
+    h / NEWTON_TOL_STEP below that step), at most ``newton.loosest``."""
     am, af, gam, beta = co[0], co[1], co[2], co[3]
     c2 = (1.0 - af) * beta * h * h / (1.0 - am)
     beta_v = beta * h / gam
@@ -516,7 +518,8 @@ def solve_step(work, newton, co, t, h, held, nodes, params, control, stats, an):
         left = stride * rate / (1.0 - rate) if rate < 1.0 else np.inf
         tol = newton.tol
         if newton.loosest > 0.0 and min(stride, left) > tol:
-            tol = max(tol, min(newton.loosest, NEWTON_SHARE * local_error(work, an, co, h, nodes.free)))
+            tol = max(tol, min(newton.loosest, NEWTON_SHARE * min(1.0, h / NEWTON_TOL_STEP)
+                                * local_error(work, an, co, h, nodes.free)))
         if not slow_body and (stride <= tol or left <= tol):
             if it == 0 and newton.loosest > 0.0:
                 control[FIRST_RATE] = min(1.0, CARRY_GROWTH * control[FIRST_RATE])
