@@ -95,8 +95,9 @@ NEWTON_SHARE = 0.1       # with fixed steps Newton stops once its remaining erro
 # truncation estimate (Hairer & Wanner IV.8 stop at 0.01 to 0.1 of the error tolerance), times h / NEWTON_TOL_STEP
 # below that step: a position error e left in X is an error e / beta_v in V, which grows as 1 / h against the
 # velocity's own local error (without the factor, a pinned chain at 1 ms left solve errors of 0.74 times the scheme's
-# own error; with it 0.056, tests/test_from_run.py): the solve then adds at most a tenth to the step's error. On WD0050 at 0.1 s, 4.0 instead of 6.25 iterations a step, the fairlead tension's error
-# 0.4672 % of its range instead of 0.4662 %
+# own error; with it 0.056, tests/test_from_run.py): the solve then adds at most a tenth to the step's error. On
+# WD0050 at 0.1 s, 4.0 instead of 6.25 iterations a step, the fairlead tension's error 0.4672 % of its range instead
+# of 0.4662 %
 NEWTON_LOOSEST = 1e-4     # ... but never looser than this strain of the shortest segment: the estimate is unfiltered
 # (a stiff mode's, at a touchdown, is many times its true error), and without a ceiling WD0050's Newton failed at a
 # touchdown at 0.1 s after steps stopped centimetres short of their force balance. Not at rho_inf = 1: a solve within
